@@ -1,0 +1,233 @@
+"""Gibbs-Appell equations of motion in free flight (MODEL.md §5-6).
+
+    M(q) q'' = Q(q, q', t) - h(q, q'),     M = sum m J^T J + I a a^T,
+                                           h = sum m J^T kappa
+
+with Q the elastic, damping, gravity, cork and shaker forces.  Coordinates
+not in ``free`` are held fixed: their rows are dropped and their
+accelerations are zero (their velocities must be zero too).
+
+Argument convention of every kernel here (see :mod:`workbench.model`):
+``P, tab, kc, free`` describe the model, ``ex`` the excitation, and
+``rec, mat, vec`` are scratch.  All functions are jit-compiled; those that
+can fail return a status code of :mod:`workbench.core.layout`.
+"""
+import math
+
+import numba as nb
+
+from ..config import CHOLESKY_REL_PIVOT, JIT, JIT_INLINE
+from . import layout as ly
+from .excitation import shaker_force
+from .kinematics import compute_frames, element, n_elements, tip_row
+
+
+@nb.njit(**JIT)
+def fill_stiffness_damping(P, kc):
+    """Linear stiffness kc[KC_K] and damping kc[KC_C] (9, 9), MODEL.md §5.
+
+    Per beam: bending EI/L^3 [[12, -6L], [-6L, 4L^2]] on (w, phi) and axial
+    EA/L on u (exact for the Hermite shapes); damping C = beta K per beam.
+    The optional springs k_v, k_psi on the loose body (0 in the paper's
+    model) are undamped.
+    """
+    K = kc[ly.KC_K]
+    C = kc[ly.KC_C]
+    K[:, :] = 0.0
+    C[:, :] = 0.0
+    for i0, L, EI, EA, beta in ((ly.W_A, P[ly.P_L_A], P[ly.P_EI_A], P[ly.P_EA_A], P[ly.P_BETA_A]),
+                                (ly.W_B, P[ly.P_L_B], P[ly.P_EI_B], P[ly.P_EA_B], P[ly.P_BETA_B])):
+        kb = EI / L ** 3
+        K[i0, i0] = 12.0 * kb
+        K[i0, i0 + 1] = -6.0 * L * kb
+        K[i0 + 1, i0] = -6.0 * L * kb
+        K[i0 + 1, i0 + 1] = 4.0 * L * L * kb
+        K[i0 + 2, i0 + 2] = EA / L
+        for i in range(i0, i0 + 3):
+            for j in range(i0, i0 + 3):
+                C[i, j] = beta * K[i, j]
+    K[ly.V, ly.V] = P[ly.P_K_V]
+    K[ly.PSI, ly.PSI] = P[ly.P_K_PSI]
+
+
+@nb.njit(**JIT_INLINE)
+def cork_force(s, sd, P):
+    """Cork force on the slide s (dyn), MODEL.md §6: k sign(s)|s|^n + c s'."""
+    n = P[ly.P_CORK_N]
+    k = P[ly.P_CORK_K]
+    a = abs(s)
+    if n == 1.0:
+        spring = k * s
+    elif n == 2.0:
+        spring = k * s * a
+    elif n == 3.0:
+        spring = k * s * a * a
+    else:
+        spring = k * math.copysign(a ** n, s)
+    return spring + P[ly.P_CORK_C] * sd
+
+
+@nb.njit(**JIT_INLINE)
+def cork_energy(s, P):
+    """Cork potential k |s|^(n+1) / (n+1) (erg), MODEL.md §6."""
+    n = P[ly.P_CORK_N]
+    return P[ly.P_CORK_K] * abs(s) ** (n + 1.0) / (n + 1.0)
+
+
+@nb.njit(**JIT_INLINE)
+def assemble_inertia(q, qd, P, tab, rec, mat, vec):
+    """Fill M (mat[MAT_M]), h (vec[VEC_H]) and gravity (vec[VEC_Q]); return V_gravity.
+
+    M (g, g cm, g cm^2 by coordinate), h = sum m J^T kappa and
+    Q_gravity = sum m J^T (0, -g) (dyn, dyn cm).  Only the upper triangle is
+    summed, then mirrored.  Returns the gravitational energy sum m g y (erg).
+    """
+    M = mat[ly.MAT_M]
+    h = vec[ly.VEC_H]
+    Q = vec[ly.VEC_Q]
+    g = P[ly.P_GRAV]
+    for i in range(ly.N_DOF):
+        h[i] = 0.0
+        Q[i] = 0.0
+        for j in range(ly.N_DOF):
+            M[i, j] = 0.0
+    compute_frames(q, qd, P, tab, rec)
+    pt = rec[ly.REC_POINT]
+    v_grav = 0.0
+    for k in range(n_elements(P)):
+        m, rot, _ = element(k, q, qd, P, tab, rec)
+        for i in range(ly.N_DOF):
+            mjx = m * pt[ly.JX + i]
+            mjy = m * pt[ly.JY + i]
+            ra = rot * pt[ly.AA + i]
+            if mjx == 0.0 and mjy == 0.0 and ra == 0.0:
+                continue
+            for j in range(i, ly.N_DOF):
+                M[i, j] += mjx * pt[ly.JX + j] + mjy * pt[ly.JY + j] + ra * pt[ly.AA + j]
+            h[i] += mjx * pt[ly.KX] + mjy * pt[ly.KY]
+            Q[i] -= mjy * g
+        v_grav += m * g * pt[ly.RY]
+    for i in range(ly.N_DOF):
+        for j in range(i):
+            M[i, j] = M[j, i]
+    return v_grav
+
+
+@nb.njit(**JIT_INLINE)
+def add_applied_forces(t, q, qd, P, tab, kc, ex, Q):
+    """Add elastic, damping, cork and shaker forces to Q (dyn, dyn cm)."""
+    K = kc[ly.KC_K]
+    C = kc[ly.KC_C]
+    for i in range(ly.N_DOF):
+        acc = 0.0
+        for j in range(ly.N_DOF):
+            acc += K[i, j] * q[j] + C[i, j] * qd[j]
+        Q[i] -= acc
+    Q[ly.S] -= cork_force(q[ly.S], qd[ly.S], P)
+    # Shaker: J^T (0, F) at force1; the vertical Jacobian row of a beam A
+    # point is (N1, N2) on (w_A, phi_A).
+    F = shaker_force(t, ex)
+    row = tab[tip_row(P, ly.R_FORCE1)]
+    Q[ly.W_A] += row[ly.T_N1] * F
+    Q[ly.PHI_A] += row[ly.T_N2] * F
+
+
+@nb.njit(**JIT_INLINE)
+def solve_free(free, mat, b, x):
+    """Solve M_ff x_f = b_f by Cholesky (M = mat[MAT_M]); x of fixed coordinates = 0.
+
+    Overwrites mat[MAT_CHOL].  Returns a status code.
+    """
+    n = free.shape[0]
+    L = mat[ly.MAT_CHOL]
+    M = mat[ly.MAT_M]
+    for i in range(ly.N_DOF):
+        x[i] = 0.0
+    big = 0.0
+    for i in range(n):
+        big = max(big, M[free[i], free[i]])
+    for j in range(n):
+        d = M[free[j], free[j]]
+        for k in range(j):
+            d -= L[j, k] * L[j, k]
+        if not d > CHOLESKY_REL_PIVOT * big:
+            return ly.ERR_SINGULAR_MASS
+        d = math.sqrt(d)
+        L[j, j] = d
+        inv = 1.0 / d
+        for i in range(j + 1, n):
+            acc = M[free[i], free[j]]
+            for k in range(j):
+                acc -= L[i, k] * L[j, k]
+            L[i, j] = acc * inv
+    # forward L z = b (z kept in x's free slots), then back L^T x = z
+    for i in range(n):
+        acc = b[free[i]]
+        for k in range(i):
+            acc -= L[i, k] * x[free[k]]
+        x[free[i]] = acc / L[i, i]
+    for i in range(n - 1, -1, -1):
+        acc = x[free[i]]
+        for k in range(i + 1, n):
+            acc -= L[k, i] * x[free[k]]
+        x[free[i]] = acc / L[i, i]
+    return ly.OK
+
+
+@nb.njit(**JIT_INLINE)
+def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
+    """First-order right-hand side y' = (q', q'') of the 18-state system.
+
+    Units: y = (q, q') in cm, rad and their rates; t in s.  Returns a status.
+    """
+    q = y[:ly.N_DOF]
+    qd = y[ly.N_DOF:]
+    for i in range(ly.N_DOF):
+        ydot[i] = qd[i]
+    assemble_inertia(q, qd, P, tab, rec, mat, vec)
+    Q = vec[ly.VEC_Q]
+    add_applied_forces(t, q, qd, P, tab, kc, ex, Q)
+    b = vec[ly.VEC_RHS]
+    for i in range(ly.N_DOF):
+        b[i] = Q[i] - vec[ly.VEC_H, i]
+    return solve_free(free, mat, b, ydot[ly.N_DOF:])
+
+
+@nb.njit(**JIT)
+def eval_rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, ydot):
+    """:func:`rhs` as a compiled entry point: ``eval_rhs(t, y, *model, ex, *work, ydot)``."""
+    return rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
+
+
+@nb.njit(**JIT)
+def eval_inertia(q, qd, P, tab, kc, free, rec, mat, vec, stages):
+    """:func:`assemble_inertia` as an entry point: ``eval_inertia(q, qd, *model, *work)``.
+
+    Leaves M in mat[MAT_M], h in vec[VEC_H], gravity in vec[VEC_Q]; returns V_gravity.
+    """
+    return assemble_inertia(q, qd, P, tab, rec, mat, vec)
+
+
+@nb.njit(**JIT)
+def energies(y, P, tab, kc, free, rec, mat, vec, stages, out):
+    """Energies of state y (erg) into out: kinetic, elastic, gravity, cork.
+
+    Called as ``energies(y, *model, *work, out)``.
+    Elastic includes the optional loose-body springs; cork is the potential
+    of the cork spring.  Damping, forcing and contact do not enter.
+    """
+    q = y[:ly.N_DOF]
+    qd = y[ly.N_DOF:]
+    v_grav = assemble_inertia(q, qd, P, tab, rec, mat, vec)
+    M = mat[ly.MAT_M]
+    K = kc[ly.KC_K]
+    kin = 0.0
+    ela = 0.0
+    for i in range(ly.N_DOF):
+        for j in range(ly.N_DOF):
+            kin += 0.5 * qd[i] * M[i, j] * qd[j]
+            ela += 0.5 * q[i] * K[i, j] * q[j]
+    out[0] = kin
+    out[1] = ela
+    out[2] = v_grav
+    out[3] = cork_energy(q[ly.S], P)

@@ -1,0 +1,80 @@
+"""Fixed-step classical Runge-Kutta (RK4) integration, jit-compiled.
+
+One step of size dt advances y by (k1 + 2 k2 + 2 k3 + k4) dt / 6; global
+error O(dt^4).  Output is decimated: every ``decim``-th step is stored.  The
+step is its own function so that event handling (issue 3) re-integrates
+partial steps with the same code.  Arguments follow
+:mod:`workbench.core.dynamics`; ``stages`` (N_STAGES, 18) is scratch.
+"""
+import math
+
+import numba as nb
+
+from ..config import JIT, JIT_INLINE
+from . import layout as ly
+from .dynamics import rhs
+
+# Butcher tableau of classical RK4: stage times c, stage weights for the
+# next stage's state, and the final weights b.
+_C = (0.0, 0.5, 0.5, 1.0)
+_A_NEXT = (0.5, 0.5, 1.0)
+_B = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
+
+
+@nb.njit(**JIT_INLINE)
+def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, y_new):
+    """One RK4 step from (t, y) into y_new (may not alias y); returns a status."""
+    n = y.shape[0]
+    yt = stages[ly.STAGE_TMP]
+    for i in range(n):
+        yt[i] = y[i]
+    for st in range(4):
+        status = rhs(t + _C[st] * dt, yt, P, tab, kc, free, ex, rec, mat, vec, stages[st])
+        if status != ly.OK:
+            return status
+        if st < 3:
+            h = _A_NEXT[st] * dt
+            for i in range(n):
+                yt[i] = y[i] + h * stages[st, i]
+    for i in range(n):
+        y_new[i] = y[i] + dt * (_B[0] * stages[0, i] + _B[1] * stages[1, i]
+                                + _B[2] * stages[2, i] + _B[3] * stages[3, i])
+        if not math.isfinite(y_new[i]):
+            return ly.ERR_NAN
+    return ly.OK
+
+
+@nb.njit(**JIT)
+def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, vec,
+                    stages, out_t, out_y):
+    """Integrate n_steps RK4 steps of size dt (s) from (t0, y0).
+
+    Stores the initial state and every ``decim``-th state into ``out_t``
+    (n_out,) and ``out_y`` (n_out, 18), n_out >= n_steps // decim + 1.
+    Returns ``(status, n_stored)``; on failure the rows stored so far are
+    valid and the failing state is not stored.
+    """
+    n_out = out_t.shape[0]
+    if (out_y.shape[0] != n_out or n_out < n_steps // decim + 1
+            or y0.shape[0] != ly.N_STATE or decim < 1):
+        return ly.ERR_BAD_INPUT, 0
+    y_cur = stages[ly.STAGE_CUR]
+    y_next = stages[ly.STAGE_NEXT]
+    for i in range(ly.N_STATE):
+        y_cur[i] = y0[i]
+        out_y[0, i] = y0[i]
+    out_t[0] = t0
+    stored = 1
+    for step in range(1, n_steps + 1):
+        status = rk4_step(t0 + (step - 1) * dt, y_cur, dt, P, tab, kc, free, ex,
+                          rec, mat, vec, stages, y_next)
+        if status != ly.OK:
+            return status, stored
+        for i in range(ly.N_STATE):
+            y_cur[i] = y_next[i]
+        if step % decim == 0:
+            out_t[stored] = t0 + step * dt
+            for i in range(ly.N_STATE):
+                out_y[stored, i] = y_cur[i]
+            stored += 1
+    return ly.OK, stored

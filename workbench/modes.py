@@ -1,0 +1,53 @@
+"""Natural frequencies of the model linearised about the undeformed state.
+
+At q = 0, q' = 0 the linearised free vibration is M(0) x'' + K_lin x = 0 with
+M(0) the kernel's mass matrix and K_lin the elastic stiffness plus the
+cork's tangent stiffness at s = 0 (k for the linear and static models, 0 for
+the quadratic and cubic ones) and the optional loose-body springs.  Gravity's
+geometric stiffness is not included: the undeformed state is not the static
+equilibrium, so its linearisation is the customary unloaded one.
+
+Joint ``locked`` holds s = v = psi = 0; joint ``free`` leaves them to the
+cork alone, so v and psi (and s with a quadratic or cubic cork) have no
+stiffness and give rigid-body modes at 0 Hz.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from . import model as mdl
+from .core import layout as ly
+from .core.dynamics import eval_inertia
+from .params import ParameterError, Parameters
+
+
+def linear_matrices(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """M(0) and K_lin restricted to the moving coordinates, and their names."""
+    if joint not in ("locked", "free"):
+        raise ParameterError(f"joint must be 'locked' or 'free', got {joint!r}")
+    model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
+    work = mdl.make_work()
+    zero = np.zeros(ly.N_DOF)
+    eval_inertia(zero, zero, *model, *work)
+    M = work.mat[ly.MAT_M].copy()
+    K = model.kc[ly.KC_K].copy()
+    n, k, _ = p.cork_law
+    if n == 1.0:
+        K[ly.S, ly.S] += k
+    f = model.free
+    return M[np.ix_(f, f)], K[np.ix_(f, f)], [ly.COORD_NAMES[i] for i in f]
+
+
+def natural_frequencies(p: Parameters, joint: str = "locked") -> np.ndarray:
+    """Natural frequencies (Hz), ascending; rigid-body modes give 0."""
+    M, K, _ = linear_matrices(p, joint)
+    lam = scipy.linalg.eigh(K, M, eigvals_only=True)
+    return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
+
+
+def mode_shapes(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Frequencies (Hz), mass-normalised mode shapes (columns) and coordinate names."""
+    M, K, names = linear_matrices(p, joint)
+    lam, vec = scipy.linalg.eigh(K, M)
+    return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi), vec, names
