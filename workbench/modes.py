@@ -39,15 +39,23 @@ def linear_matrices(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, n
     return M[np.ix_(f, f)], K[np.ix_(f, f)], [ly.COORD_NAMES[i] for i in f]
 
 
+#: Eigenvalues below this fraction of the largest are rigid-body modes (0 Hz).
+RIGID_REL = 1e-12
+
+
+def _to_hz(lam: np.ndarray) -> np.ndarray:
+    lam = np.where(lam < RIGID_REL * np.max(np.abs(lam)), 0.0, lam)
+    return np.sqrt(lam) / (2.0 * np.pi)
+
+
 def natural_frequencies(p: Parameters, joint: str = "locked") -> np.ndarray:
-    """Natural frequencies (Hz), ascending; rigid-body modes give 0."""
+    """Natural frequencies (Hz), ascending; rigid-body modes give exactly 0."""
     M, K, _ = linear_matrices(p, joint)
-    lam = scipy.linalg.eigh(K, M, eigvals_only=True)
-    return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
+    return _to_hz(scipy.linalg.eigh(K, M, eigvals_only=True))
 
 
 def mode_shapes(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Frequencies (Hz), mass-normalised mode shapes (columns) and coordinate names."""
     M, K, names = linear_matrices(p, joint)
     lam, vec = scipy.linalg.eigh(K, M)
-    return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi), vec, names
+    return _to_hz(lam), vec, names

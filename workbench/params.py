@@ -255,8 +255,13 @@ def _to_cgs(values: dict[str, Any]) -> dict[str, Any]:
         if name in out:
             raise ParameterError(f"parameter {name!r} given twice (as {key!r})")
         if factor != 1.0:
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ParameterError(f"{key} must be a number, got {value!r}")
+            # check in the user's unit, so the message speaks it
+            meta = dict(FIELDS[name].metadata)
+            meta["unit"] = key[len(name) + 1:]
+            for bound in ("lo", "hi"):
+                if meta[bound] is not None:
+                    meta[bound] = meta[bound] / factor
+            _check_number(key, value, meta)
             value = value * factor
         out[name] = value
     return out
@@ -269,9 +274,11 @@ def _suffixed_names() -> list[str]:
 
 def _range_text(meta) -> str:
     lo, hi = meta["lo"], meta["hi"]
-    left = "(" if meta["lo_open"] else "["
-    right = ")" if meta["hi_open"] else "]"
-    return f"{left}{'-inf' if lo is None else lo:g}, {'inf' if hi is None else hi:g}{right}"
+    left = "(" if meta["lo_open"] or lo is None else "["
+    right = ")" if meta["hi_open"] or hi is None else "]"
+    lo_text = "-inf" if lo is None else f"{lo:g}"
+    hi_text = "inf" if hi is None else f"{hi:g}"
+    return f"{left}{lo_text}, {hi_text}{right}"
 
 
 def _check_number(name, value, meta):

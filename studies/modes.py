@@ -1,0 +1,67 @@
+"""Modal table of the model: natural frequencies for tip mass on/off, joint
+locked/free and every cork model, linearised about the undeformed state.
+
+Writes ``modes.csv``, ``modes.md`` and ``provenance.json`` into ``--out``.
+Run by ``make study`` until the sweep studies arrive (issue 4).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from importlib import metadata
+from pathlib import Path
+
+import pandas as pd
+
+from workbench import __version__
+from workbench.modes import natural_frequencies
+from workbench.params import CORK_MODELS, Parameters
+
+N_MODES = 6
+
+
+def table() -> pd.DataFrame:
+    rows = []
+    for tip in (True, False):
+        for joint in ("locked", "free"):
+            for cork in (CORK_MODELS if joint == "free" else ["cubic"]):
+                p = Parameters(tip_mass=tip, cork=cork)
+                f = natural_frequencies(p, joint)
+                rigid = int((f == 0.0).sum())
+                elastic = f[f > 0.0][:N_MODES]
+                row = {"tip_mass": "on" if tip else "off", "joint": joint,
+                       "cork": cork if joint == "free" else "-", "rigid_modes": rigid}
+                row.update({f"f{i + 1}_hz": v for i, v in enumerate(elastic)})
+                rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--out", type=Path, required=True)
+    args = parser.parse_args()
+    start = time.perf_counter()
+    df = table()
+    args.out.mkdir(parents=True, exist_ok=True)
+    df.to_csv(args.out / "modes.csv", index=False, float_format="%.4f")
+    note = ("Natural frequencies (Hz) of the 9-DOF model linearised about the undeformed "
+            "state (gravity's geometric stiffness omitted). Joint 'locked' holds s = v = psi = 0; "
+            "'free' leaves them to the cork, whose tangent stiffness at s = 0 is zero for the "
+            "quadratic and cubic models: those coordinates are rigid-body modes (counted in "
+            "rigid_modes, 0 Hz) and the elastic frequencies follow.\n\n")
+    (args.out / "modes.md").write_text("# Modal table\n\n" + note
+                                       + df.to_markdown(index=False, floatfmt=".3f") + "\n")
+    provenance = {
+        "study": "modes", "workbench": __version__, "python": platform.python_version(),
+        "machine": platform.platform(), "wall_s": time.perf_counter() - start,
+        "packages": {k: metadata.version(k) for k in ("numba", "numpy", "scipy", "pandas")},
+        "parameters": Parameters().to_dict(),
+    }
+    (args.out / "provenance.json").write_text(json.dumps(provenance, indent=1, default=str))
+    print(f"wrote {args.out}/modes.csv, modes.md, provenance.json")
+
+
+if __name__ == "__main__":
+    main()

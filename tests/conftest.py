@@ -1,0 +1,29 @@
+"""Shared fixtures: parameter sets and random states within physical ranges."""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))   # tests/reference.py, tests/fe_reference.py
+
+from workbench.params import Parameters  # noqa: E402
+
+#: Typical magnitudes of (w_A, phi_A, u_A, s, v, psi, w_B, phi_B, u_B) for
+#: random states: centimetres of deflection, tenths of a radian.
+Q_SCALE = np.array([3.0, 0.12, 0.01, 0.1, 0.05, 0.02, 3.0, 0.12, 0.01])
+QD_SCALE = np.array([50.0, 2.0, 0.5, 5.0, 5.0, 1.0, 50.0, 2.0, 0.5])
+
+
+def random_state(rng):
+    return np.concatenate([rng.normal(size=9) * Q_SCALE, rng.normal(size=9) * QD_SCALE])
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(20261122)
+
+
+@pytest.fixture(params=[True, False], ids=["tip", "notip"])
+def params(request):
+    return Parameters(tip_mass=request.param)

@@ -1,0 +1,78 @@
+"""Natural frequencies against an independent FE model and closed forms."""
+import json
+import math
+
+import numpy as np
+import pytest
+from fe_reference import cantilever_frequencies, locked_frequencies
+
+from workbench.cli import main
+from workbench.modes import natural_frequencies
+from workbench.params import Parameters
+
+BETA1_L = 1.875104    # first root of cos(bL) cosh(bL) = -1 (Blevins, Formulas for
+                      # Natural Frequency and Mode Shape, Table 8-1)
+
+
+def test_fe_reference_reproduces_the_uniform_cantilever():
+    p = Parameters()
+    f1 = cantilever_frequencies(p.l_a, p.e_a * p.inertia_a, p.mu_a)[0]
+    exact = BETA1_L ** 2 / p.l_a ** 2 * math.sqrt(p.e_a * p.inertia_a / p.mu_a) / (2 * math.pi)
+    assert f1 == pytest.approx(exact, rel=1e-6)
+
+
+@pytest.mark.parametrize("tip", [True, False])
+def test_locked_frequencies_match_a_fine_fe_model(tip):
+    p = Parameters(tip_mass=tip)
+    fe = locked_frequencies(p, n_el=40)
+    model = natural_frequencies(p, "locked")
+    bending = model[:3]   # the axial modes lie near 1 kHz and above
+    assert bending[0] == pytest.approx(fe[0], rel=0.005)
+    assert bending[1] == pytest.approx(fe[1], rel=0.005)
+    assert bending[2] == pytest.approx(fe[2], rel=0.05)
+
+
+def test_uniform_cantilever_limit():
+    # Everything but beam A made negligible, joint and beam B held: the model
+    # is one cubic Hermite cantilever, whose Rayleigh-Ritz frequency is the
+    # closed form's from above, within 0.48 % (3.533 vs 3.516 sqrt(EI/mu L^4)).
+    tiny = 1e-9
+    p = Parameters(m3=tiny, i3=tiny, m4=tiny, i4=tiny, mu_b=tiny, rho_i_b=tiny, tip_mass=False,
+                   rho_i_a=tiny)
+    from workbench import model as mdl
+    from workbench.modes import linear_matrices  # noqa: F401  (same path as natural_frequencies)
+    import scipy.linalg
+    from workbench.core import layout as ly
+    from workbench.core.dynamics import eval_inertia
+    m = mdl.build(p, fixed=("s", "v", "psi", "w_B", "phi_B", "u_B"))
+    work = mdl.make_work()
+    eval_inertia(np.zeros(9), np.zeros(9), *m, *work)
+    f = m.free
+    lam = scipy.linalg.eigh(m.kc[ly.KC_K][np.ix_(f, f)], work.mat[ly.MAT_M][np.ix_(f, f)],
+                            eigvals_only=True)
+    beta1_l = (lam[0] * p.mu_a / (p.e_a * p.inertia_a)) ** 0.25 * p.l_a
+    assert beta1_l > BETA1_L
+    assert beta1_l == pytest.approx(BETA1_L, rel=0.0025)
+
+
+def test_free_joint_has_the_rigid_modes_of_the_missing_stiffness():
+    f_cubic = natural_frequencies(Parameters(cork="cubic"), "free")
+    f_linear = natural_frequencies(Parameters(cork="linear"), "free")
+    assert np.sum(f_cubic == 0.0) == 3       # s, v, psi unrestrained at s = 0
+    assert np.sum(f_linear == 0.0) == 2      # v, psi
+    assert np.all(np.diff(f_linear) >= 0)
+
+
+def test_cli_modes_json(capsys):
+    assert main(["modes", "--tip-mass", "off", "--joint", "locked", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    expected = natural_frequencies(Parameters(tip_mass=False), "locked")
+    assert out["frequencies_hz"] == pytest.approx(list(expected))
+    assert out["frequencies_hz"] == sorted(out["frequencies_hz"])
+
+
+def test_cli_reports_bad_input(capsys):
+    assert main(["modes", "--set", "gap_mm=9"]) == 2
+    assert "gap_mm = 9 mm is outside the allowed range (0, 5] mm" in capsys.readouterr().err
+    assert main(["modes", "--cork", "cubic", "--set", "m3=nan"]) == 2
+    assert "m3 must be finite" in capsys.readouterr().err
