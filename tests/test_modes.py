@@ -4,9 +4,13 @@ import math
 
 import numpy as np
 import pytest
+import scipy.linalg
 from fe_reference import cantilever_frequencies, locked_frequencies
 
+from workbench import model as mdl
 from workbench.cli import main
+from workbench.core import layout as ly
+from workbench.core.dynamics import eval_inertia
 from workbench.modes import natural_frequencies
 from workbench.params import Parameters
 
@@ -39,11 +43,6 @@ def test_uniform_cantilever_limit():
     tiny = 1e-9
     p = Parameters(m3=tiny, i3=tiny, m4=tiny, i4=tiny, mu_b=tiny, rho_i_b=tiny, tip_mass=False,
                    rho_i_a=tiny)
-    from workbench import model as mdl
-    from workbench.modes import linear_matrices  # noqa: F401  (same path as natural_frequencies)
-    import scipy.linalg
-    from workbench.core import layout as ly
-    from workbench.core.dynamics import eval_inertia
     m = mdl.build(p, fixed=("s", "v", "psi", "w_B", "phi_B", "u_B"))
     work = mdl.make_work()
     eval_inertia(np.zeros(9), np.zeros(9), *m, *work)
