@@ -1,5 +1,8 @@
 """The ``workbench`` command line.
 
+    workbench run --gap-mm G --tip-mass on|off --cork MODEL
+                  [--freq-hz F | --chirp F0:F1:T | --free-decay CM | --impulse joint|tip]
+                  [--force-n A] [--mu M] [--duration T] [--dt DT] [--out FILE.parquet] [--json]
     workbench modes [--tip-mass on|off] [--joint locked|free] [--cork MODEL] [--json]
     workbench params [--json]
 
@@ -69,6 +72,54 @@ def _cmd_modes(args) -> int:
     return 0
 
 
+def _chirp(text: str) -> tuple[float, float, float]:
+    try:
+        f0, f1, sweep = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--chirp expects F0:F1:T (Hz:Hz:s), got {text!r}") from None
+    return f0, f1, sweep
+
+
+def _excitation(args):
+    from . import excitation as X
+    force = X.DEFAULT_FORCE_N if args.force_n is None else args.force_n
+    if args.freq_hz is not None:
+        return X.sine(force, args.freq_hz, ramp_s=args.ramp_s)
+    if args.chirp is not None:
+        return X.chirp(force, *args.chirp, ramp_s=args.ramp_s)
+    if args.impulse is not None:
+        hammer = X.hammer_joint if args.impulse == "joint" else X.hammer_tip
+        peak = X.DEFAULT_HAMMER_N if args.force_n is None else args.force_n
+        return hammer(peak, args.pulse_s, args.hit_s)
+    return None
+
+
+def _cmd_run(args) -> int:
+    from .simulate import simulate
+    p = _parameters(args)
+    changes = {}
+    if args.gap_mm is not None:
+        changes["gap_mm"] = args.gap_mm
+    if args.mu is not None:
+        changes["mu_s"] = changes["mu_k"] = args.mu
+    p = p.replace(**changes) if changes else p
+    n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse))
+    if n_drives > 1:
+        raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse")
+    run = simulate(p, _excitation(args), args.duration, dt=args.dt, output_hz=args.output_hz,
+                   initial=args.initial, free_decay_cm=args.free_decay,
+                   progress=not args.json and sys.stderr.isatty())
+    if args.out:
+        run.to_parquet(args.out)
+    summary = run.summary()
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        for key, value in summary.items():
+            print(f"{key:>24}: {value}")
+    return 0 if run.ok else 1
+
+
 def _cmd_params(args) -> int:
     p = _parameters(args)
     rows = describe()
@@ -98,6 +149,31 @@ def build_parser() -> argparse.ArgumentParser:
                        help="locked: s = v = psi = 0; free: held only by the cork")
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.set_defaults(func=_cmd_modes)
+
+    run = sub.add_parser("run", help="simulate one run with contact (MODEL.md §7-9)")
+    _add_model_options(run)
+    run.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
+    run.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
+    drive = run.add_argument_group("excitation (one; default none)")
+    drive.add_argument("--freq-hz", type=float, help="sine at force1, frequency (Hz)")
+    drive.add_argument("--chirp", type=_chirp, metavar="F0:F1:T", help="linear chirp F0 -> F1 Hz over T s")
+    drive.add_argument("--free-decay", type=float, metavar="CM",
+                       help="release from a static tip deflection (cm, + up)")
+    drive.add_argument("--impulse", choices=("joint", "tip"),
+                       help="half-sine hammer: vertical at the joint body, or axial at the tip")
+    drive.add_argument("--force-n", type=float,
+                       help="shaker amplitude or hammer peak (N); default: see README")
+    drive.add_argument("--ramp-s", type=float, default=1.0, help="soft-start ramp of sine/chirp (s)")
+    drive.add_argument("--pulse-s", type=float, default=1e-3, help="hammer pulse duration (s)")
+    drive.add_argument("--hit-s", type=float, default=0.01, help="hammer pulse start (s)")
+    run.add_argument("--duration", type=float, default=1.0, help="simulated time (s)")
+    run.add_argument("--dt", type=float, help="RK4 step (s); default from the model's fastest mode")
+    run.add_argument("--output-hz", type=float, default=1000.0, help="sample rate of the signals")
+    run.add_argument("--initial", choices=("static", "paper"), default="static",
+                     help="static equilibrium (default) or the paper's undeformed free start")
+    run.add_argument("--out", metavar="FILE.parquet", help="write the signals (and events) to Parquet")
+    run.add_argument("--json", action="store_true", help="print one JSON object")
+    run.set_defaults(func=_cmd_run)
 
     params = sub.add_parser("params", help="list every parameter with its unit, range and source")
     _add_model_options(params)

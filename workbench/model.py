@@ -36,8 +36,11 @@ JOINT = ("s", "v", "psi")
 Model = namedtuple("Model", "P tab kc free")
 
 #: Scratch of one thread of kernel calls: ``rec`` (N_RECS, N_REC) point
-#: records, ``mat`` (2, 9, 9), ``vec`` (N_VEC, 9), ``stages`` (N_STAGES, 18).
-Work = namedtuple("Work", "rec mat vec stages")
+#: records, ``mat`` (2, 9, 9), ``vec`` (N_VEC, 9), ``stages`` (N_STAGES,
+#: N_AUG), contact geometry ``cg`` (2 N_POINTS, N_CG), constraint work ``cw``
+#: (N_CW, 9), regime record ``rg`` (N_RG,) and event values ``ev``
+#: (N_EV_ROWS, N_EV).
+Work = namedtuple("Work", "rec mat vec stages cg cw rg ev")
 
 
 def coordinate_index(name: str | int) -> int:
@@ -73,6 +76,7 @@ def pack(p: Parameters) -> np.ndarray:
     P[ly.P_X_FORCE] = p.x_force
     P[ly.P_C_STRAIN] = p.c_strain
     P[ly.P_N_GAUSS] = p.n_gauss
+    P[ly.P_X_ACCEL1], P[ly.P_X_ACCEL2] = p.x_accel1, p.x_accel2
     return P
 
 
@@ -112,7 +116,9 @@ def build(p: Parameters, fixed: Iterable[str | int] = ()) -> Model:
 def make_work() -> Work:
     """Fresh scratch arrays for one thread of kernel calls."""
     return Work(rec=np.zeros((ly.N_RECS, ly.N_REC)), mat=np.zeros((2, ly.N_DOF, ly.N_DOF)),
-                vec=np.zeros((ly.N_VEC, ly.N_DOF)), stages=np.zeros((ly.N_STAGES, ly.N_STATE)))
+                vec=np.zeros((ly.N_VEC, ly.N_DOF)), stages=np.zeros((ly.N_STAGES, ly.N_AUG)),
+                cg=np.zeros((2 * ly.N_POINTS, ly.N_CG)), cw=np.zeros((ly.N_CW, ly.N_DOF)),
+                rg=np.zeros(ly.N_RG), ev=np.zeros((ly.N_EV_ROWS, ly.N_EV)))
 
 
 def state(q=None, qd=None) -> np.ndarray:

@@ -18,8 +18,8 @@ import numba as nb
 
 from ..config import CHOLESKY_REL_PIVOT, JIT, JIT_INLINE
 from . import layout as ly
-from .excitation import shaker_force
-from .kinematics import compute_frames, element, n_elements, tip_row
+from .excitation import hammer_force, shaker_force
+from .kinematics import beam_b_point, compute_frames, element, n_elements, rigid_point, tip_row
 
 
 @nb.njit(**JIT)
@@ -114,8 +114,15 @@ def assemble_inertia(q, qd, P, tab, rec, mat, vec):
 
 
 @nb.njit(**JIT_INLINE)
-def add_applied_forces(t, q, qd, P, tab, kc, ex, Q):
-    """Add elastic, damping, cork and shaker forces to Q (dyn, dyn cm)."""
+def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
+    """Add elastic, damping, cork, shaker and hammer forces to Q = vec[VEC_Q].
+
+    Units dyn, dyn cm.  The frames in ``rec`` must be current; the point
+    record rows are overwritten by a hammer.  Writes the excitation's power
+    (erg/s) and the shaker and hammer forces (dyn) into vec[VEC_AUX].
+    """
+    Q = vec[ly.VEC_Q]
+    aux = vec[ly.VEC_AUX]
     K = kc[ly.KC_K]
     C = kc[ly.KC_C]
     for i in range(ly.N_DOF):
@@ -130,19 +137,36 @@ def add_applied_forces(t, q, qd, P, tab, kc, ex, Q):
     row = tab[tip_row(P, ly.R_FORCE1)]
     Q[ly.W_A] += row[ly.T_N1] * F
     Q[ly.PHI_A] += row[ly.T_N2] * F
+    power = F * (row[ly.T_N1] * qd[ly.W_A] + row[ly.T_N2] * qd[ly.PHI_A])
+    aux[ly.AUX_F_SHAKER] = F
+    # Hammer: J^T F e at the struck point, e its direction.
+    Fh = hammer_force(t, ex)
+    aux[ly.AUX_F_HAMMER] = Fh
+    if Fh != 0.0:
+        pt = rec[ly.REC_POINT]
+        if int(ex[ly.X_KIND]) == ly.EXC_HAMMER_JOINT:   # vertical, joint body base
+            rigid_point(rec, ly.REC_JOINT, 0.0, 0.0, ly.REC_POINT)
+            ex_, ey_ = 0.0, 1.0
+        else:                                           # along beam B's axis at its tip
+            beam_b_point(tab[tip_row(P, ly.R_TIP_B)], q, qd, P, rec, ly.REC_POINT)
+            angle = q[ly.PHI_A] + q[ly.PSI] + q[ly.PHI_B]
+            ex_, ey_ = math.cos(angle), math.sin(angle)
+        for i in range(ly.N_DOF):
+            gi = Fh * (ex_ * pt[ly.JX + i] + ey_ * pt[ly.JY + i])
+            Q[i] += gi
+            power += gi * qd[i]
+    aux[ly.AUX_P_EXT] = power
 
 
 @nb.njit(**JIT_INLINE)
-def solve_free(free, mat, b, x):
-    """Solve M_ff x_f = b_f by Cholesky (M = mat[MAT_M]); x of fixed coordinates = 0.
+def factor_free(free, mat):
+    """Cholesky factor of M_ff (M = mat[MAT_M], f the free coordinates) into mat[MAT_CHOL].
 
-    Overwrites mat[MAT_CHOL].  Returns a status code.
+    Returns a status code.
     """
     n = free.shape[0]
     L = mat[ly.MAT_CHOL]
     M = mat[ly.MAT_M]
-    for i in range(ly.N_DOF):
-        x[i] = 0.0
     big = 0.0
     for i in range(n):
         big = max(big, M[free[i], free[i]])
@@ -160,6 +184,16 @@ def solve_free(free, mat, b, x):
             for k in range(j):
                 acc -= L[i, k] * L[j, k]
             L[i, j] = acc * inv
+    return ly.OK
+
+
+@nb.njit(**JIT_INLINE)
+def solve_factored(free, mat, b, x):
+    """x = M_ff^-1 b_f with the factor of :func:`factor_free`; x of fixed coordinates = 0."""
+    n = free.shape[0]
+    L = mat[ly.MAT_CHOL]
+    for i in range(ly.N_DOF):
+        x[i] = 0.0
     # forward L z = b (z kept in x's free slots), then back L^T x = z
     for i in range(n):
         acc = b[free[i]]
@@ -171,22 +205,35 @@ def solve_free(free, mat, b, x):
         for k in range(i + 1, n):
             acc -= L[k, i] * x[free[k]]
         x[free[i]] = acc / L[i, i]
-    return ly.OK
+
+
+@nb.njit(**JIT_INLINE)
+def solve_free(free, mat, b, x):
+    """Solve M_ff x_f = b_f by Cholesky (M = mat[MAT_M]); x of fixed coordinates = 0.
+
+    Overwrites mat[MAT_CHOL].  Returns a status code.
+    """
+    status = factor_free(free, mat)
+    if status == ly.OK:
+        solve_factored(free, mat, b, x)
+    return status
 
 
 @nb.njit(**JIT_INLINE)
 def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
-    """First-order right-hand side y' = (q', q'') of the 18-state system.
+    """First-order right-hand side y' = (q', q'') of the 18-state system in free flight.
 
     Units: y = (q, q') in cm, rad and their rates; t in s.  Returns a status.
+    Leaves M's Cholesky factor in mat[MAT_CHOL] and the scalars of
+    vec[VEC_AUX] (gravity energy, excitation power and forces).
     """
     q = y[:ly.N_DOF]
     qd = y[ly.N_DOF:]
     for i in range(ly.N_DOF):
         ydot[i] = qd[i]
-    assemble_inertia(q, qd, P, tab, rec, mat, vec)
+    vec[ly.VEC_AUX, ly.AUX_VGRAV] = assemble_inertia(q, qd, P, tab, rec, mat, vec)
+    add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec)
     Q = vec[ly.VEC_Q]
-    add_applied_forces(t, q, qd, P, tab, kc, ex, Q)
     b = vec[ly.VEC_RHS]
     for i in range(ly.N_DOF):
         b[i] = Q[i] - vec[ly.VEC_H, i]
@@ -194,13 +241,13 @@ def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
 
 
 @nb.njit(**JIT)
-def eval_rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, ydot):
+def eval_rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
     """:func:`rhs` as a compiled entry point: ``eval_rhs(t, y, *model, ex, *work, ydot)``."""
     return rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
 
 
 @nb.njit(**JIT)
-def eval_inertia(q, qd, P, tab, kc, free, rec, mat, vec, stages):
+def eval_inertia(q, qd, P, tab, kc, free, rec, mat, vec, stages, cg, cw, rg, ev):
     """:func:`assemble_inertia` as an entry point: ``eval_inertia(q, qd, *model, *work)``.
 
     Leaves M in mat[MAT_M], h in vec[VEC_H], gravity in vec[VEC_Q]; returns V_gravity.
@@ -209,7 +256,7 @@ def eval_inertia(q, qd, P, tab, kc, free, rec, mat, vec, stages):
 
 
 @nb.njit(**JIT)
-def energies(y, P, tab, kc, free, rec, mat, vec, stages, out):
+def energies(y, P, tab, kc, free, rec, mat, vec, stages, cg, cw, rg, ev, out):
     """Energies of state y (erg) into out: kinetic, elastic, gravity, cork.
 
     Called as ``energies(y, *model, *work, out)``.

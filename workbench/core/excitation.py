@@ -5,6 +5,9 @@
 
 Both multiplied by a soft-start ramp 1/2 (1 - cos(pi t / t_ramp)) while
 t < t_ramp, so the lightly damped first mode is not kicked by a sudden start.
+
+Hammer pulses (MODEL.md §8, seed §4.3 and §5.4) are half-sines
+F = F0 sin(pi (t - t_hit) / width) for t_hit <= t <= t_hit + width.
 """
 import math
 
@@ -36,3 +39,16 @@ def shaker_force(t, ex):
     else:
         return 0.0
     return ex[ly.X_AMP] * ramp(t, ex[ly.X_RAMP]) * math.sin(2.0 * math.pi * phase)
+
+
+@nb.njit(**JIT_INLINE)
+def hammer_force(t, ex):
+    """Hammer pulse force (dyn) at time t (s); 0 unless ex is a hammer excitation."""
+    kind = int(ex[ly.X_KIND])
+    if kind != ly.EXC_HAMMER_JOINT and kind != ly.EXC_HAMMER_TIP:
+        return 0.0
+    tau = t - ex[ly.X_T_HIT]
+    width = ex[ly.X_WIDTH]
+    if tau < 0.0 or tau > width:
+        return 0.0
+    return ex[ly.X_AMP] * math.sin(math.pi * tau / width)

@@ -1,10 +1,13 @@
 """Fixed-step classical Runge-Kutta (RK4) integration, jit-compiled.
 
 One step of size dt advances y by (k1 + 2 k2 + 2 k3 + k4) dt / 6; global
-error O(dt^4).  Output is decimated: every ``decim``-th step is stored.  The
-step is its own function so that event handling (issue 3) re-integrates
-partial steps with the same code.  Arguments follow
-:mod:`workbench.core.dynamics`; ``stages`` (N_STAGES, 18) is scratch.
+error O(dt^4).  The state is the augmented one (layout ``A_*``): (q, q')
+and the running integrals of the energy account, so that the account has
+the integrator's accuracy.  :func:`rk4_step` serves both the free-flight
+integration here and the event-driven integration of
+:mod:`workbench.core.hybrid`, which re-integrates partial steps with it.
+Arguments follow :mod:`workbench.core.constrained`; ``stages``
+(N_STAGES, N_AUG) is scratch.
 """
 import math
 
@@ -12,7 +15,7 @@ import numba as nb
 
 from ..config import JIT, JIT_INLINE
 from . import layout as ly
-from .dynamics import rhs
+from .constrained import rhs_regime
 
 # Butcher tableau of classical RK4: stage times c, stage weights for the
 # next stage's state, and the final weights b.
@@ -21,17 +24,23 @@ _A_NEXT = (0.5, 0.5, 1.0)
 _B = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
 
 
-@nb.njit(**JIT_INLINE)
-def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, y_new):
-    """One RK4 step from (t, y) into y_new (may not alias y); returns a status."""
-    n = y.shape[0]
+@nb.njit(**JIT)
+def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, y_new):
+    """One RK4 step from (t, y) into y_new (may not alias y) in the regime of rg.
+
+    k1 = f(t, y) must already be in stages[STAGE_K1] (the caller evaluated
+    it, e.g. for the events at the step's start).  Returns a status.
+    """
+    n = ly.N_AUG
     yt = stages[ly.STAGE_TMP]
     for i in range(n):
-        yt[i] = y[i]
+        stages[0, i] = stages[ly.STAGE_K1, i]
     for st in range(4):
-        status = rhs(t + _C[st] * dt, yt, P, tab, kc, free, ex, rec, mat, vec, stages[st])
-        if status != ly.OK:
-            return status
+        if st > 0:
+            status = rhs_regime(t + _C[st] * dt, yt, P, tab, kc, free, ex, rec, mat, vec,
+                                cg, cw, rg, stages[st])
+            if status != ly.OK:
+                return status
         if st < 3:
             h = _A_NEXT[st] * dt
             for i in range(n):
@@ -46,31 +55,40 @@ def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, y_new):
 
 @nb.njit(**JIT)
 def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, vec,
-                    stages, out_t, out_y):
-    """Integrate n_steps RK4 steps of size dt (s) from (t0, y0).
+                    stages, cg, cw, rg, ev, out_t, out_y):
+    """Integrate n_steps RK4 steps of size dt (s) from (t0, y0) in free flight.
 
-    Stores the initial state and every ``decim``-th state into ``out_t``
-    (n_out,) and ``out_y`` (n_out, 18), n_out >= n_steps // decim + 1.
-    Returns ``(status, n_stored)``; on failure the rows stored so far are
-    valid and the failing state is not stored.
+    No contact: the loose body passes through the plates, so use it with the
+    joint locked or held by springs (MODEL.md §7 contact is in
+    :mod:`workbench.core.hybrid`).  y0 is (q, q') (18,).  Stores the initial
+    state and every ``decim``-th state into ``out_t`` (n_out,) and ``out_y``
+    (n_out, 18), n_out >= n_steps // decim + 1.  Returns ``(status,
+    n_stored)``; on failure the rows stored so far are valid and the failing
+    state is not stored.
     """
     n_out = out_t.shape[0]
     if (out_y.shape[0] != n_out or n_out < n_steps // decim + 1
             or y0.shape[0] != ly.N_STATE or decim < 1):
         return ly.ERR_BAD_INPUT, 0
+    rg[ly.RG_SET] = 0.0
     y_cur = stages[ly.STAGE_CUR]
     y_next = stages[ly.STAGE_NEXT]
+    for i in range(ly.N_AUG):
+        y_cur[i] = y0[i] if i < ly.N_STATE else 0.0
     for i in range(ly.N_STATE):
-        y_cur[i] = y0[i]
         out_y[0, i] = y0[i]
     out_t[0] = t0
     stored = 1
     for step in range(1, n_steps + 1):
-        status = rk4_step(t0 + (step - 1) * dt, y_cur, dt, P, tab, kc, free, ex,
-                          rec, mat, vec, stages, y_next)
+        t = t0 + (step - 1) * dt
+        status = rhs_regime(t, y_cur, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                            stages[ly.STAGE_K1])
+        if status == ly.OK:
+            status = rk4_step(t, y_cur, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                              stages, y_next)
         if status != ly.OK:
             return status, stored
-        for i in range(ly.N_STATE):
+        for i in range(ly.N_AUG):
             y_cur[i] = y_next[i]
         if step % decim == 0:
             out_t[stored] = t0 + step * dt

@@ -58,7 +58,9 @@ P_K_PSI = 32     # optional spring on psi (g cm^2/s^2); 0 in the paper's model
 P_X_FORCE = 33   # shaker position on beam A (cm)
 P_C_STRAIN = 34  # distance from the neutral axis to the surface (cm)
 P_N_GAUSS = 35   # Gauss points per beam (stored as a float)
-N_PARAMS = 36
+P_X_ACCEL1 = 36  # accel1 on the joint body, from its base (cm)
+P_X_ACCEL2 = 37  # accel2 on the loose body, from its inner end (cm)
+N_PARAMS = 38
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):
@@ -86,23 +88,36 @@ X_F0 = 3         # chirp start frequency (Hz)
 X_F1 = 4         # chirp end frequency (Hz)
 X_T_SWEEP = 5    # chirp duration (s)
 X_RAMP = 6       # soft-start ramp duration (s); 0 for none
-N_EXC = 7
+X_T_HIT = 7      # hammer: start of the half-sine pulse (s)
+X_WIDTH = 8      # hammer: pulse duration (s)
+N_EXC = 9
 
 EXC_NONE = 0
-EXC_SINE = 1
-EXC_CHIRP = 2
+EXC_SINE = 1          # shaker at force1
+EXC_CHIRP = 2         # shaker at force1
+EXC_HAMMER_JOINT = 3  # vertical half-sine pulse at the joint body's base (MODEL.md §8)
+EXC_HAMMER_TIP = 4    # half-sine pulse along beam B's axis at its tip (§4.3)
 
 # --- status codes ------------------------------------------------------------
 OK = 0
 ERR_NAN = 1
 ERR_SINGULAR_MASS = 2
 ERR_BAD_INPUT = 3
+ERR_EVENT_FLOOD = 4
+ERR_NO_IMPACT_CANDIDATE = 5
+ERR_NO_REGIME = 6
+LOG_FULL = 7     # not an error: the event log is full, call again to continue
 
 MESSAGES = {
     OK: "finished",
     ERR_NAN: "the state became NaN or infinite",
     ERR_SINGULAR_MASS: "the mass matrix is not positive definite",
     ERR_BAD_INPUT: "the kernel was given inconsistent array sizes",
+    ERR_EVENT_FLOOD: "Zeno-like flood of events: too many events within one step",
+    ERR_NO_IMPACT_CANDIDATE: "no consistent momentum-transfer candidate for an impact",
+    ERR_NO_REGIME: "no consistent regime after a transition (every candidate violated "
+                   "a force or friction condition)",
+    LOG_FULL: "the event log is full (the run continues in a new chunk)",
 }
 
 # --- rows of the shape table ``tab`` -----------------------------------------
@@ -140,7 +155,134 @@ N_RECS = 4
 # --- work matrices and vectors -----------------------------------------------
 KC_K, KC_C = 0, 1                # kc (2, 9, 9): stiffness, damping
 MAT_M, MAT_CHOL = 0, 1           # mat (2, 9, 9): mass matrix, its Cholesky factor
-VEC_H, VEC_Q, VEC_RHS = 0, 1, 2  # vec (3, 9): h = sum m J^T kappa, forces, Q - h
-N_VEC = 3
-STAGE_TMP, STAGE_CUR, STAGE_NEXT = 4, 5, 6   # stages (7, 18): k1..k4 then state buffers
-N_STAGES = 7
+VEC_H, VEC_Q, VEC_RHS, VEC_AUX = 0, 1, 2, 3  # vec (4, 9): h = sum m J^T kappa, forces, Q - h,
+AUX_VGRAV, AUX_P_EXT, AUX_F_SHAKER, AUX_F_HAMMER = 0, 1, 2, 3   # and scalars of the last rhs:
+N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer forces (dyn)
+# stages (N_STAGES, N_AUG): k1..k4, then state buffers.  STAGE_K1 keeps k1 of
+# the current step for re-integrating partial steps; STAGE_TRY and STAGE_HI
+# hold trial states while an event is bracketed (HI: the earliest state
+# found past an event), STAGE_KNEXT and STAGE_KTRY the right-hand sides at
+# STAGE_NEXT and STAGE_TRY; STAGE_QD holds q'- in [0, 9) and a candidate
+# q'+ in [9, 18) during an impact.
+STAGE_TMP, STAGE_CUR, STAGE_NEXT, STAGE_K1, STAGE_TRY, STAGE_HI = 4, 5, 6, 7, 8, 9
+STAGE_KNEXT, STAGE_KTRY, STAGE_QD = 10, 11, 12
+N_STAGES = 13
+
+# --- augmented state -----------------------------------------------------------
+# The integrators carry (q, q') and these running integrals (erg), integrated
+# by the same RK4 steps as the motion, for the energy account.
+A_WORK = N_STATE        # work of the applied excitation (shaker or hammer)
+A_DAMP = N_STATE + 1    # dissipated by structural damping, int q'^T C q' dt
+A_CORK = N_STATE + 2    # dissipated by the cork damper, int c s'^2 dt
+A_FRIC = N_STATE + 3    # dissipated by Coulomb friction while slipping
+A_CONSTR = N_STATE + 4  # work of the normal and sticking contact forces (ideally 0)
+N_AUG = N_STATE + 5
+
+# --- contact (MODEL.md §7) ---------------------------------------------------
+N_POINTS = 4
+# Geometry record cg (2 N_POINTS, N_CG): rows G1..G4 are the gaps g_k, rows
+# T1..T4 the tangential coordinates tau_k; columns the value, gradient with
+# respect to (s, v, psi) and Hessian (upper triangle).
+CG_G = 0                     # row CG_G + k: gap of point k + 1 (cm)
+CG_T = N_POINTS              # row CG_T + k: tangential coordinate of point k + 1 (cm)
+CG_VAL = 0
+CG_DS, CG_DV, CG_DPSI = 1, 2, 3
+CG_HSS, CG_HSV, CG_HSP, CG_HVV, CG_HVP, CG_HPP = 4, 5, 6, 7, 8, 9
+N_CG = 10
+
+# Contact sets (points 0-based), in the order of MODEL.md §7: set k of regimes
+# 2k - 1 (stick) and 2k (slip).  -1 marks no point.
+N_SETS = 9
+SET_FIRST = (-1, 0, 1, 2, 3, 0, 0, 1, 1)
+SET_SECOND = (-1, -1, -1, -1, -1, 2, 3, 2, 3)
+CONTACT_CODE = (0, 1, 2, 3, 4, 13, 14, 23, 24)
+N_REGIMES = 2 * N_SETS - 1
+
+# Regime record rg (N_RG,): the regime being integrated (input) and the
+# contact forces of the last right-hand side (output).
+RG_SET = 0       # contact set index 0..8
+RG_STICK = 1     # 1.0 sticking, 0.0 slipping
+RG_SIGN = 2      # slipping: sign of tau' of the set's points (+1 or -1)
+RG_LN = 3        # RG_LN + k: normal force lambda_n of point k + 1 (dyn), 0 if open
+RG_LT = RG_LN + N_POINTS   # sticking: tangential force lambda_t (dyn)
+RG_VGRAV = RG_LT + 1       # gravitational energy of the last state (erg)
+RG_TPT = RG_VGRAV + 1      # sticking: whose tangential row, 0 the set's first point, 1 its second
+N_RG = RG_TPT + 1
+
+# Constraint work array cw (N_CW, 9): up to 3 constraint rows A, their force
+# directions B (A when sticking; W_n - mu sigma W_t when slipping), the
+# columns X = M^-1 B^T, and a small dense system D lambda = c.
+MAX_ROWS = 3
+CW_A = 0
+CW_B = CW_A + MAX_ROWS
+CW_X = CW_B + MAX_ROWS
+CW_D = CW_X + MAX_ROWS       # rows CW_D..: D in columns 0..2, c in column 3, lambda in 4
+CW_C_COL, CW_L_COL = MAX_ROWS, MAX_ROWS + 1
+N_CW = CW_D + MAX_ROWS
+
+# Event values ev (N_EV_ROWS, N_EV): every event function changes sign from
+# + to - when its event happens; functions not watched in a regime are +1.
+# Rows: values at the step's start, end, a trial point, the earliest point
+# found past an event (HI); gap rates at the start, end and trial point.
+EV_START, EV_END, EV_TRY, EV_HI, EV_RATE_START, EV_RATE_END, EV_RATE_TRY = range(7)
+N_EV_ROWS = 7
+EV_GAP = 0                   # EV_GAP + k: open gap g_k (impact); rates hold g_k'
+EV_LAMBDA = EV_GAP + N_POINTS  # EV_LAMBDA + k: lambda_n of active point k (separation)
+EV_STICK = EV_LAMBDA + N_POINTS  # mu_s sum lambda_n - |lambda_t| (stick -> slip)
+EV_SLIP = EV_STICK + 1           # sigma tau' of the set's first point (slip -> stick)
+N_EV = EV_SLIP + 1
+
+# Event log (max_events, N_LOG)
+KIND_START, KIND_IMPACT, KIND_SEPARATION, KIND_STICK_SLIP, KIND_SLIP_STICK = 0, 1, 2, 3, 4
+EVENT_KINDS = ("start", "impact", "separation", "stick-slip", "slip-stick")
+LOG_T = 0        # time (s)
+LOG_KIND = 1     # KIND_*
+LOG_FROM = 2     # regime before
+LOG_TO = 3       # regime after
+LOG_POINT = 4    # the point whose event it was (1..4), 0 for none
+LOG_P = 5        # LOG_P + k: normal impulse of point k + 1 (dyn s)
+LOG_PT = LOG_P + N_POINTS    # tangential impulse (dyn s)
+LOG_DKE = LOG_PT + 1         # kinetic energy lost (erg)
+N_LOG = LOG_DKE + 1
+
+# Run statistics st (N_ST,)
+ST_MAX_PEN = 0       # largest penetration -g of an open gap at an accepted state (cm)
+ST_MAX_DRIFT = 1     # largest |g| of an active gap before its projection (cm)
+ST_N_EVENTS = 2
+ST_N_IMPACTS = 3
+ST_E_IMPACT = 4      # kinetic energy lost in impacts (erg)
+ST_T = 5             # time reached (s)
+ST_STEP = 6          # steps completed
+N_ST = 7
+
+# Signals stored at the output rate (out_sig columns), CGS units.
+SIGNALS = ("force1", "hammer", "strain1", "strain2", "accel1", "accel2", "accel3", "tip_y",
+           "gap1", "gap2", "gap3", "gap4", "lambda_n1", "lambda_n2", "lambda_n3", "lambda_n4",
+           "lambda_t", "regime",
+           "e_kin", "e_elastic", "e_gravity", "e_cork",
+           "w_excitation", "d_structural", "d_cork", "d_friction", "d_impact", "w_constraint")
+SIGNAL_UNITS = ("dyn", "dyn", "-", "-", "cm/s^2", "cm/s^2", "cm/s^2", "cm",
+                "cm", "cm", "cm", "cm", "dyn", "dyn", "dyn", "dyn", "dyn", "-") + ("erg",) * 10
+SIG_FORCE1 = SIGNALS.index("force1")
+SIG_HAMMER = SIGNALS.index("hammer")
+SIG_STRAIN1 = SIGNALS.index("strain1")
+SIG_STRAIN2 = SIGNALS.index("strain2")
+SIG_ACCEL1 = SIGNALS.index("accel1")
+SIG_ACCEL2 = SIGNALS.index("accel2")
+SIG_ACCEL3 = SIGNALS.index("accel3")
+SIG_TIP_Y = SIGNALS.index("tip_y")
+SIG_GAP = SIGNALS.index("gap1")
+SIG_LN = SIGNALS.index("lambda_n1")
+SIG_LT = SIGNALS.index("lambda_t")
+SIG_REGIME = SIGNALS.index("regime")
+SIG_E_KIN = SIGNALS.index("e_kin")
+SIG_E_ELA = SIGNALS.index("e_elastic")
+SIG_E_GRAV = SIGNALS.index("e_gravity")
+SIG_E_CORK = SIGNALS.index("e_cork")
+SIG_W_EXT = SIGNALS.index("w_excitation")
+SIG_D_STRUCT = SIGNALS.index("d_structural")
+SIG_D_CORK = SIGNALS.index("d_cork")
+SIG_D_FRIC = SIGNALS.index("d_friction")
+SIG_D_IMPACT = SIGNALS.index("d_impact")
+SIG_W_CONSTR = SIGNALS.index("w_constraint")
+N_SIG = len(SIGNALS)

@@ -1,0 +1,527 @@
+"""Event-driven integration of the 17-regime model (MODEL.md §7), jit-compiled.
+
+Fixed RK4 steps in the current regime; after each step the events of the
+regime are evaluated (every event function goes from + to - when its event
+happens, layout ``EV_*``):
+
+    open gap g_k + GAP_EPS                  impact of point k
+    lambda_n,k + LAMBDA_EPS, active k       separation of point k (or, in a sticking
+                                            double contact, the move of its
+                                            tangential row to the other point)
+    mu_s sum lambda_n - |lambda_t| + tol    stick -> slip (tol: FRICTION_REL_EPS)
+    sigma tau' + RATE_EPS                   slip -> stick (or reversal)
+
+A sign change is bracketed by re-integrating the partial step from the
+step's start (one RK4 step of theta dt) and located by the Illinois method
+to EVENT_TIME_TOL.  A gap that dips below zero and back within one step
+(grazing) is caught by the cubic Hermite interpolant of the gap over the
+step, whose minimum is then checked by re-integration.  Several events in a
+step are taken in time order: the earliest is applied, and the rest of the
+step is integrated again in the new regime.
+
+Impacts are momentum transfers (:func:`impact`): the candidate regimes,
+double contacts first, sticking before sliding, are tried in order and the
+first consistent one is taken.  Each event is written to the log (layout
+``LOG_*``); failures end the run with a status code, keeping the samples
+and the log written so far.
+"""
+import numba as nb
+
+from ..config import (EVENT_TIME_TOL, GAP_EPS, JIT, JIT_INLINE, LAMBDA_EPS,
+                      MAX_EVENTS_PER_STEP, RATE_EPS)
+from . import layout as ly
+from .constrained import (apply_impulse, kinetic_energy, project, rhs_regime, settle,
+                          stick_margin, stick_tolerance, tangent_point)
+from .contact import fill_geometry, in_set, regime_of, row_rate
+from .integrate import rk4_step
+from .sensors import fill_signals
+
+#: Candidate contact sets of an impact, double contacts first.
+_IMPACT_ORDER = (5, 6, 7, 8, 1, 2, 3, 4)
+#: A point whose gap is below this (cm) at an impact may take part in it.
+_CLOSED_GAP = 1e-9
+
+
+@nb.njit(**JIT)
+def event_values(y, P, cg, rg, ev, row, rate_row):
+    """Event functions of the regime in rg at y into ev[row] (gap rates into ev[rate_row]).
+
+    The contact forces in rg must be those of y (rhs_regime just ran).
+    """
+    fill_geometry(y, P, cg)
+    qd = y[ly.N_DOF:ly.N_STATE]
+    set_index = int(rg[ly.RG_SET])
+    stick = rg[ly.RG_STICK] != 0.0
+    for p in range(ly.N_POINTS):
+        if in_set(set_index, p):
+            ev[row, ly.EV_GAP + p] = 1.0
+            ev[rate_row, ly.EV_GAP + p] = 0.0
+            ev[row, ly.EV_LAMBDA + p] = rg[ly.RG_LN + p] + LAMBDA_EPS
+        else:
+            ev[row, ly.EV_GAP + p] = cg[ly.CG_G + p, ly.CG_VAL] + GAP_EPS
+            ev[rate_row, ly.EV_GAP + p] = row_rate(cg, ly.CG_G + p, qd)
+            ev[row, ly.EV_LAMBDA + p] = 1.0
+    ev[row, ly.EV_STICK] = 1.0
+    ev[row, ly.EV_SLIP] = 1.0
+    if set_index > 0:
+        if stick:
+            ev[row, ly.EV_STICK] = stick_margin(P, rg) + stick_tolerance(P, rg)
+        else:
+            rate = row_rate(cg, ly.CG_T + tangent_point(set_index, int(rg[ly.RG_TPT])), qd)
+            ev[row, ly.EV_SLIP] = rg[ly.RG_SIGN] * rate + RATE_EPS
+
+
+@nb.njit(**JIT_INLINE)
+def _copy(stages, src, dst):
+    for i in range(ly.N_AUG):
+        stages[dst, i] = stages[src, i]
+
+
+@nb.njit(**JIT_INLINE)
+def _copy_ev(ev, src, dst):
+    for i in range(ly.N_EV):
+        ev[dst, i] = ev[src, i]
+
+
+@nb.njit(**JIT)
+def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
+    """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY."""
+    y = stages[ly.STAGE_CUR]
+    y_try = stages[ly.STAGE_TRY]
+    status = rk4_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                      stages, y_try)
+    if status == ly.OK:
+        status = rhs_regime(t + theta * h, y_try, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
+                            rg, stages[ly.STAGE_KTRY])
+    if status == ly.OK:
+        event_values(y_try, P, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
+    return status
+
+
+@nb.njit(**JIT_INLINE)
+def _hermite_min(f0, f1, m0, m1):
+    """Minimum over theta in [0, 1] of the cubic Hermite interpolant; returns (theta, value).
+
+    f0, f1 values and m0, m1 slopes (per unit theta) at the ends.
+    """
+    # p(x) = f0 h00 + m0 h10 + f1 h01 + m1 h11; p'(x) = a x^2 + b x + c
+    a = 6.0 * f0 + 3.0 * m0 - 6.0 * f1 + 3.0 * m1
+    b = -6.0 * f0 - 4.0 * m0 + 6.0 * f1 - 2.0 * m1
+    c = m0
+    best_x = 0.0
+    best_v = f0
+    if f1 < best_v:
+        best_x = 1.0
+        best_v = f1
+    roots = (-1.0, -1.0)
+    if abs(a) > 1e-300:
+        disc = b * b - 4.0 * a * c
+        if disc >= 0.0:
+            sq = disc ** 0.5
+            roots = ((-b - sq) / (2.0 * a), (-b + sq) / (2.0 * a))
+    elif abs(b) > 1e-300:
+        roots = (-c / b, -1.0)
+    for x in roots:
+        if 0.0 < x < 1.0:
+            x2 = x * x
+            x3 = x2 * x
+            v = (f0 * (2.0 * x3 - 3.0 * x2 + 1.0) + m0 * (x3 - 2.0 * x2 + x)
+                 + f1 * (-2.0 * x3 + 3.0 * x2) + m1 * (x3 - x2))
+            if v < best_v:
+                best_x = x
+                best_v = v
+    return best_x, best_v
+
+
+@nb.njit(**JIT)
+def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
+    """The earliest event in the step (t, t + h) from STAGE_CUR to STAGE_NEXT.
+
+    Returns ``(status, event, theta)``: event -1 if none; else the state
+    just past the event (within EVENT_TIME_TOL) is in STAGE_HI at
+    t + theta h.
+    """
+    best = -1
+    best_theta = 2.0
+    for e in range(ly.N_EV):
+        f0 = ev[ly.EV_START, e]
+        f1 = ev[ly.EV_END, e]
+        if f0 < 0.0:
+            continue
+        hi = -1.0
+        fhi = 0.0
+        if f1 < 0.0:
+            hi = 1.0
+            fhi = f1
+        elif e < ly.EV_GAP + ly.N_POINTS and f0 < 1.0:
+            # grazing: the gap's cubic Hermite interpolant over the step
+            m0 = h * ev[ly.EV_RATE_START, e]
+            m1 = h * ev[ly.EV_RATE_END, e]
+            if m0 < 0.0 and m1 > 0.0:
+                xm, vm = _hermite_min(f0, f1, m0, m1)
+                if vm < 0.0 and xm < best_theta:
+                    status = _trial(xm, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                                    ev, stages)
+                    if status != ly.OK:
+                        return status, -1, 0.0
+                    if ev[ly.EV_TRY, e] < 0.0:
+                        hi = xm
+                        fhi = ev[ly.EV_TRY, e]
+                        _copy(stages, ly.STAGE_TRY, ly.STAGE_HI)
+                        _copy_ev(ev, ly.EV_TRY, ly.EV_HI)
+        if hi < 0.0:
+            continue
+        if best >= 0 and hi >= best_theta:
+            # an earlier event is already known: does e change sign before it?
+            if ev[ly.EV_HI, e] >= 0.0:
+                continue
+            hi = best_theta
+            fhi = ev[ly.EV_HI, e]
+        elif hi == 1.0:
+            _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
+            _copy_ev(ev, ly.EV_END, ly.EV_HI)
+        lo = 0.0
+        flo = f0
+        side = 0
+        for it in range(200):
+            if (hi - lo) * h <= EVENT_TIME_TOL:
+                break
+            if it % 5 == 4 or fhi == flo:
+                x = 0.5 * (lo + hi)
+            else:
+                x = hi - fhi * (hi - lo) / (fhi - flo)
+                if not (lo < x < hi):
+                    x = 0.5 * (lo + hi)
+            status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages)
+            if status != ly.OK:
+                return status, -1, 0.0
+            f = ev[ly.EV_TRY, e]
+            if f < 0.0:
+                hi = x
+                fhi = f
+                _copy(stages, ly.STAGE_TRY, ly.STAGE_HI)
+                _copy_ev(ev, ly.EV_TRY, ly.EV_HI)
+                if side == -1:
+                    flo *= 0.5
+                side = -1
+            else:
+                lo = x
+                flo = f
+                if side == 1:
+                    fhi *= 0.5
+                side = 1
+        best = e
+        best_theta = hi
+    return ly.OK, best, best_theta
+
+
+@nb.njit(**JIT_INLINE)
+def _log(log, n_log, t, kind, reg_from, reg_to, point):
+    """Start a log row (impulses and energy zero); returns the row index."""
+    r = log[n_log]
+    for j in range(ly.N_LOG):
+        r[j] = 0.0
+    r[ly.LOG_T] = t
+    r[ly.LOG_KIND] = kind
+    r[ly.LOG_FROM] = reg_from
+    r[ly.LOG_TO] = reg_to
+    r[ly.LOG_POINT] = point
+    return n_log
+
+
+@nb.njit(**JIT)
+def impact(t, y, point, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, log, n_log, st):
+    """Momentum transfer at an impact of ``point`` (0-based) at state y (MODEL.md §7).
+
+    rhs_regime must have run at y (M and its factor current).  Tries the
+    candidate regimes containing the point and otherwise only points that
+    are closed now; accepts the first with non-negative normal impulses,
+    sticking impulse inside the friction cone (or, sliding, no reversal of
+    the slip), no closed point approaching afterwards, and no kinetic
+    energy gained.  Writes the log row and leaves rg at the new regime (not
+    yet settled).  Returns a status.
+    """
+    fill_geometry(y, P, cg)
+    old_set = int(rg[ly.RG_SET])
+    reg_from = regime_of(old_set, rg[ly.RG_STICK] != 0.0)
+    qd_minus = stages[ly.STAGE_QD, 0:ly.N_DOF]
+    qd_plus = stages[ly.STAGE_QD, ly.N_DOF:ly.N_STATE]
+    for j in range(ly.N_DOF):
+        qd_minus[j] = y[ly.N_DOF + j]
+    ke_minus = kinetic_energy(qd_minus, mat)
+    approach = abs(row_rate(cg, ly.CG_G + point, qd_minus))
+    tol_v = 1e-9 * approach + RATE_EPS
+    for cand in _IMPACT_ORDER:
+        if not in_set(cand, point):
+            continue
+        ok_members = True
+        for p in (ly.SET_FIRST[cand], ly.SET_SECOND[cand]):
+            if p >= 0 and p != point and not in_set(old_set, p) \
+                    and cg[ly.CG_G + p, ly.CG_VAL] > _CLOSED_GAP:
+                ok_members = False
+        if not ok_members:
+            continue
+        p1 = ly.SET_FIRST[cand]
+        n_normal = 1 if ly.SET_SECOND[cand] < 0 else 2
+        tau_minus = row_rate(cg, ly.CG_T + p1, qd_minus)
+        for mode in range(2):
+            stick = mode == 0
+            sign = 0.0
+            if not stick:
+                if tau_minus == 0.0:
+                    continue
+                sign = 1.0 if tau_minus > 0.0 else -1.0
+            m = apply_impulse(cand, stick, sign, 0, qd_minus, qd_plus, P, free, mat, cg, cw)
+            scale = 0.0
+            total_n = 0.0
+            for r in range(m):
+                scale = max(scale, abs(cw[ly.CW_D + r, ly.CW_L_COL]))
+            ok = True
+            for r in range(n_normal):
+                pn = cw[ly.CW_D + r, ly.CW_L_COL]
+                total_n += pn
+                if pn < -1e-12 * scale:
+                    ok = False
+            if stick and abs(cw[ly.CW_D + n_normal, ly.CW_L_COL]) > \
+                    P[ly.P_MU_S] * total_n * (1.0 + 1e-12) + 1e-300:
+                ok = False
+            if not stick and sign * row_rate(cg, ly.CG_T + p1, qd_plus) < -tol_v:
+                ok = False
+            for p in range(ly.N_POINTS):
+                if in_set(cand, p) or cg[ly.CG_G + p, ly.CG_VAL] > _CLOSED_GAP:
+                    continue
+                if row_rate(cg, ly.CG_G + p, qd_plus) < -tol_v:
+                    ok = False
+            ke_plus = kinetic_energy(qd_plus, mat)
+            if ke_plus > ke_minus * (1.0 + 1e-12):
+                ok = False
+            if not ok:
+                continue
+            for j in range(ly.N_DOF):
+                y[ly.N_DOF + j] = qd_plus[j]
+            rg[ly.RG_SET] = cand
+            rg[ly.RG_STICK] = 1.0 if stick else 0.0
+            rg[ly.RG_SIGN] = sign
+            rg[ly.RG_TPT] = 0.0
+            row = log[_log(log, n_log, t, ly.KIND_IMPACT, reg_from, regime_of(cand, stick),
+                           point + 1)]
+            row[ly.LOG_P + p1] = cw[ly.CW_D + 0, ly.CW_L_COL]
+            if n_normal == 2:
+                row[ly.LOG_P + ly.SET_SECOND[cand]] = cw[ly.CW_D + 1, ly.CW_L_COL]
+            if stick:
+                row[ly.LOG_PT] = cw[ly.CW_D + n_normal, ly.CW_L_COL]
+            else:
+                row[ly.LOG_PT] = -P[ly.P_MU_K] * sign * total_n
+            row[ly.LOG_DKE] = ke_minus - ke_plus
+            st[ly.ST_E_IMPACT] += ke_minus - ke_plus
+            st[ly.ST_N_IMPACTS] += 1.0
+            return ly.OK
+    return ly.ERR_NO_IMPACT_CANDIDATE
+
+
+@nb.njit(**JIT)
+def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, log,
+                n_log, st):
+    """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
+
+    Returns a status; the log row n_log is written.
+    """
+    y = stages[ly.STAGE_CUR]
+    k1 = stages[ly.STAGE_K1]
+    set_index = int(rg[ly.RG_SET])
+    reg_from = regime_of(set_index, rg[ly.RG_STICK] != 0.0)
+    # The bracketed state is not projected: pull it onto the old regime first,
+    # so that e.g. a sticking slip velocity is exactly 0 when slip begins.
+    project(y, P, free, cg, cw, rg)
+    status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
+    if status != ly.OK:
+        return status
+    point = 0
+    kind = ly.KIND_START
+    if e < ly.EV_GAP + ly.N_POINTS:
+        status = impact(t, y, e - ly.EV_GAP, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                        stages, log, n_log, st)
+        if status != ly.OK:
+            return status
+        kind = ly.KIND_IMPACT
+        point = e - ly.EV_GAP + 1
+    elif e < ly.EV_LAMBDA + ly.N_POINTS:
+        p = e - ly.EV_LAMBDA
+        keep = ly.SET_FIRST[set_index] if ly.SET_FIRST[set_index] != p else ly.SET_SECOND[set_index]
+        if keep >= 0 and tangent_point(set_index, int(rg[ly.RG_TPT])) == p:
+            rg[ly.RG_TPT] = 1.0 if keep == ly.SET_SECOND[set_index] else 0.0
+        else:
+            rg[ly.RG_SET] = 0.0 if keep < 0 else float(keep + 1)   # set {keep + 1}
+            rg[ly.RG_TPT] = 0.0
+        kind = ly.KIND_SEPARATION
+        point = p + 1
+    elif e == ly.EV_STICK:
+        rg[ly.RG_STICK] = 0.0
+        rg[ly.RG_SIGN] = -1.0 if rg[ly.RG_LT] > 0.0 else 1.0
+        kind = ly.KIND_STICK_SLIP
+        point = ly.SET_FIRST[set_index] + 1
+    else:
+        rg[ly.RG_STICK] = 1.0
+        kind = ly.KIND_SLIP_STICK
+        point = ly.SET_FIRST[set_index] + 1
+    sign_before = rg[ly.RG_SIGN]
+    status = settle(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
+    if status != ly.OK:
+        return status
+    if (kind == ly.KIND_SLIP_STICK and int(rg[ly.RG_SET]) == set_index
+            and rg[ly.RG_STICK] == 0.0 and rg[ly.RG_SIGN] == sign_before):
+        # The slip decelerated to rest, yet sticking fails by round-off and
+        # would slip on the same way: at the friction limit, where stick and
+        # slip forces agree, so the contact sticks.
+        rg[ly.RG_STICK] = 1.0
+        project(y, P, free, cg, cw, rg)
+        status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
+        if status != ly.OK:
+            return status
+    reg_to = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
+    if kind == ly.KIND_IMPACT:
+        log[n_log, ly.LOG_TO] = reg_to
+    else:
+        _log(log, n_log, t, kind, reg_from, reg_to, point)
+    event_values(y, P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+    st[ly.ST_N_EVENTS] += 1.0
+    return ly.OK
+
+
+@nb.njit(**JIT_INLINE)
+def _immediate_impact(ev):
+    """A watched gap already closed and closing at the current state (-1 if none)."""
+    for p in range(ly.N_POINTS):
+        if ev[ly.EV_START, ly.EV_GAP + p] < 0.0 and ev[ly.EV_RATE_START, ly.EV_GAP + p] < 0.0:
+            return ly.EV_GAP + p
+    return -1
+
+
+@nb.njit(**JIT)
+def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
+           out_t, out_y, out_sig):
+    y = stages[ly.STAGE_CUR]
+    k = stages[ly.STAGE_KTRY]
+    status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k)
+    if status != ly.OK:
+        return status
+    out_t[stored] = t
+    for i in range(ly.N_STATE):
+        out_y[stored, i] = y[i]
+    fill_signals(y, k, P, tab, kc, rec, mat, vec, cg, rg, st, out_sig[stored])
+    return ly.OK
+
+
+@nb.njit(**JIT)
+def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat, vec, stages,
+               cg, cw, rg, ev, out_t, out_y, out_sig, log, st):
+    """Integrate n_steps steps of dt (s) from (t0, y0) with contact events.
+
+    y0 (N_AUG,) is the augmented state; rg holds the starting regime and,
+    on return, the final one; STAGE_CUR holds the final state.  ``step0``
+    counts the steps done by earlier calls (a run in chunks): a sample is
+    stored after every step whose global number is a multiple of ``decim``,
+    and the state at t0 only when step0 == 0.  The event log ``log``
+    (capacity, N_LOG) must hold MAX_EVENTS_PER_STEP + 2 rows; when fewer
+    remain the call returns LOG_FULL after a whole step, and the caller
+    continues from STAGE_CUR with st[ST_STEP] steps done.  st accumulates
+    the run statistics (layout ST_*).
+
+    Returns ``(status, n_stored, n_log)``.
+    """
+    n_out = out_t.shape[0]
+    need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
+    if (y0.shape[0] != ly.N_AUG or decim < 1 or n_out < need or out_y.shape[0] < need
+            or out_sig.shape[0] < need or log.shape[0] < MAX_EVENTS_PER_STEP + 2):
+        return ly.ERR_BAD_INPUT, 0, 0
+    y = stages[ly.STAGE_CUR]
+    for i in range(ly.N_AUG):
+        y[i] = y0[i]
+    n_log = 0
+    stored = 0
+    t = t0
+    reg_start = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
+    status = settle(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages[ly.STAGE_K1])
+    if status != ly.OK:
+        return status, stored, n_log
+    event_values(y, P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+    if step0 == 0:
+        _log(log, n_log, t, ly.KIND_START, reg_start,
+             regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
+        n_log += 1
+    for _ in range(MAX_EVENTS_PER_STEP):
+        e = _immediate_impact(ev)
+        if e < 0:
+            break
+        status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages,
+                             log, n_log, st)
+        if status != ly.OK:
+            return status, stored, n_log
+        n_log += 1
+    if step0 == 0:
+        status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
+                        out_t, out_y, out_sig)
+        if status != ly.OK:
+            return status, stored, n_log
+        stored += 1
+    for step in range(1, n_steps + 1):
+        if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
+            return ly.LOG_FULL, stored, n_log
+        t_end = t0 + step * dt
+        n_step_events = 0
+        while True:
+            h = t_end - t
+            if h <= 1e-15 * dt:
+                break
+            status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages,
+                              stages[ly.STAGE_NEXT])
+            if status == ly.OK:
+                drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
+                st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+                status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec, mat,
+                                    vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
+            if status != ly.OK:
+                return status, stored, n_log
+            event_values(stages[ly.STAGE_NEXT], P, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+            status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
+                                      stages)
+            if status != ly.OK:
+                return status, stored, n_log
+            if e < 0:
+                _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+                _copy(stages, ly.STAGE_KNEXT, ly.STAGE_K1)
+                _copy_ev(ev, ly.EV_END, ly.EV_START)
+                for p in range(ly.N_POINTS):
+                    ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+                t = t_end
+                break
+            _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
+            t = t_end if theta >= 1.0 else t + theta * h
+            while e >= 0:
+                n_step_events += 1
+                if n_step_events > MAX_EVENTS_PER_STEP:
+                    st[ly.ST_T] = t
+                    return ly.ERR_EVENT_FLOOD, stored, n_log
+                for p in range(ly.N_POINTS):       # penetration when the event is found
+                    if not in_set(int(rg[ly.RG_SET]), p):
+                        st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN],
+                                                GAP_EPS - ev[ly.EV_HI, ly.EV_GAP + p])
+                status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
+                                     stages, log, n_log, st)
+                if status != ly.OK:
+                    st[ly.ST_T] = t
+                    return status, stored, n_log
+                n_log += 1
+                e = _immediate_impact(ev)
+        for p in range(ly.N_POINTS):
+            if not in_set(int(rg[ly.RG_SET]), p):
+                st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN], GAP_EPS - ev[ly.EV_START, ly.EV_GAP + p])
+        st[ly.ST_T] = t
+        st[ly.ST_STEP] = step0 + step
+        if (step0 + step) % decim == 0:
+            status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
+                            out_t, out_y, out_sig)
+            if status != ly.OK:
+                return status, stored, n_log
+            stored += 1
+    return ly.OK, stored, n_log

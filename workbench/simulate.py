@@ -1,0 +1,333 @@
+"""One simulation run: the ``simulate`` entry point and the :class:`Run` it returns.
+
+    run = simulate(Parameters(gap_mm=1.016), excitation.sine(2.0, 20.0, ramp_s=1.0), 10.0)
+    run.signals      # DataFrame indexed by time: q, q', sensors, contacts, energies
+    run.events       # DataFrame: time, kind, from/to regime, point, impulses, energy lost
+    run.transitions  # (from, to) regime transition counts
+    run.summary()    # the dict printed by ``workbench run --json``
+
+The kernel (:func:`workbench.core.hybrid.run_hybrid`) runs in chunks, so
+memory stays bounded, progress can be shown, and a failure keeps every
+sample and event computed before it (``run.status``, ``run.message``).
+Units are CGS (MODEL.md); ``run.units`` names them per column.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from . import model as mdl
+from .core import layout as ly
+from .core.hybrid import run_hybrid
+from .excitation import none
+from .params import ParameterError, Parameters
+from .statics import static_equilibrium, tip_load_for_deflection
+
+#: Steps :func:`default_dt` chooses from (s): each divides 1 ms.
+NICE_STEPS = (5e-5, 4e-5, 2.5e-5, 2e-5, 1e-5, 5e-6)
+#: |lambda| dt bound of :func:`default_dt`: RK4 is stable to 2.78 on the
+#: negative real axis and 2.83 on the imaginary one; 2.0 leaves room for
+#: the stiffening of contact.
+STABLE_RATE_DT = 2.0
+DEFAULT_OUTPUT_HZ = 1000.0
+
+
+def default_dt(p: Parameters) -> float:
+    """The largest step of NICE_STEPS with |lambda|_max dt <= STABLE_RATE_DT.
+
+    lambda_max from :func:`workbench.modes.fastest_rate`.  With the tip mass
+    this is 5e-5 s (capped there for accuracy); without it beam B's
+    overdamped axial mode needs 2e-5 s.
+    """
+    from .modes import fastest_rate
+    rate = fastest_rate(p)
+    for dt in NICE_STEPS:
+        if dt * rate <= STABLE_RATE_DT:
+            return dt
+    return NICE_STEPS[-1]
+_CHUNK_S = 1.0
+_LOG_ROWS = 8192
+
+Q_COLUMNS = list(ly.COORD_NAMES)
+QD_COLUMNS = [f"{n}_dot" for n in ly.COORD_NAMES]
+ENERGY_COLUMNS = ["e_kin", "e_elastic", "e_gravity", "e_cork", "w_excitation", "d_structural",
+                  "d_cork", "d_friction", "d_impact", "w_constraint"]
+
+
+@dataclass
+class Run:
+    """The result of :func:`simulate`."""
+
+    params: Parameters
+    excitation: np.ndarray
+    dt: float
+    duration: float
+    status: int
+    message: str
+    wall_s: float
+    signals: pd.DataFrame
+    events: pd.DataFrame
+    stats: dict
+    static_tip_y: float
+    initial: str
+    units: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == ly.OK
+
+    @property
+    def simulated_s(self) -> float:
+        return float(self.stats["t_reached"])
+
+    @property
+    def transitions(self) -> pd.DataFrame:
+        """Counts of (from_regime, to_regime) over the events, starting event excluded."""
+        ev = self.events[self.events.kind != "start"]
+        return (ev.groupby(["from_regime", "to_regime"]).size().rename("count").reset_index())
+
+    @property
+    def energy(self) -> pd.DataFrame:
+        """The energy account (erg) with the total E and the balance residual.
+
+        residual = E - E(0) - W_excitation + D_structural + D_cork + D_friction + D_impact
+        """
+        e = self.signals[ENERGY_COLUMNS].copy()
+        e["total"] = e.e_kin + e.e_elastic + e.e_gravity + e.e_cork
+        e["residual"] = (e.total - e.total.iloc[0] - e.w_excitation + e.d_structural + e.d_cork
+                         + e.d_friction + e.d_impact)
+        return e
+
+    def energy_balance_rel(self) -> float:
+        """Largest |residual| over the energy throughput (|W| + dissipations, or max T)."""
+        e = self.energy
+        last = e.iloc[-1]
+        throughput = (abs(last.w_excitation) + last.d_structural + last.d_cork + last.d_friction
+                      + last.d_impact)
+        if throughput <= 0.0:
+            throughput = float(e.e_kin.max())
+        return float(np.abs(e.residual).max() / throughput) if throughput > 0 else 0.0
+
+    def contact_time_share(self) -> dict[str, float]:
+        """Fraction of the simulated time spent in each contact code (from the event log)."""
+        times = list(self.events.t) + [self.simulated_s]
+        regimes = list(self.events.to_regime)
+        share: dict[str, float] = {}
+        total = self.simulated_s - float(self.events.t.iloc[0])
+        for k, reg in enumerate(regimes):
+            code = str(contact_code(int(reg)))
+            share[code] = share.get(code, 0.0) + times[k + 1] - times[k]
+        return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}
+
+    def summary(self) -> dict:
+        """Scalar results of the run (the ``workbench run --json`` object)."""
+        sig = self.signals
+        visited = set(int(r) for r in self.events.to_regime) | set(int(r) for r in sig.regime)
+        tip = sig.tip_y - self.static_tip_y
+        return {
+            "status": "ok" if self.ok else "failed",
+            "status_code": self.status,
+            "message": self.message,
+            "simulated_s": self.simulated_s,
+            "wall_s": self.wall_s,
+            "dt": self.dt,
+            "initial": self.initial,
+            "n_events": int((self.events.kind != "start").sum()),
+            "n_impacts": int((self.events.kind == "impact").sum()),
+            "regimes_visited": sorted(visited),
+            "contact_time_share": self.contact_time_share(),
+            "max_penetration_cm": float(self.stats["max_penetration_cm"]),
+            "max_drift_cm": float(self.stats["max_drift_cm"]),
+            "energy_balance_rel": self.energy_balance_rel(),
+            "impact_energy_lost_erg": float(self.stats["impact_energy_lost_erg"]),
+            "strain1_rms": float(np.std(sig.strain1)),
+            "strain2_rms": float(np.std(sig.strain2)),
+            "tip_disp_peak_cm": float(np.abs(tip).max()),
+        }
+
+    def to_parquet(self, path) -> None:
+        """Signals to ``path``; events to the same name with ``.events.parquet``."""
+        path = str(path)
+        self.signals.to_parquet(path)
+        stem = path[:-len(".parquet")] if path.endswith(".parquet") else path
+        self.events.to_parquet(stem + ".events.parquet")
+
+
+def contact_code(regime: int) -> int:
+    """The paper's contact code (0, 1, 2, 3, 4, 13, 14, 23, 24) of a regime 0..16."""
+    return ly.CONTACT_CODE[(regime + 1) // 2]
+
+
+def regime_name(regime: int) -> str:
+    """'free', or e.g. 'stick {2,3}' / 'slip {1}'."""
+    if regime == 0:
+        return "free"
+    code = str(contact_code(regime))
+    return f"{'stick' if regime % 2 else 'slip'} {{{','.join(code)}}}"
+
+
+def _positive(name, value, unit):
+    if not (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value) and value > 0):
+        raise ParameterError(f"{name} = {value!r} {unit} is outside the allowed range (0, inf) {unit}")
+    return float(value)
+
+
+def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: float | None = None):
+    """The augmented initial state (N_AUG,), its regime (set, stick) and a label.
+
+    ``initial``: "static" (equilibrium under gravity), "paper" (undeformed,
+    at rest, loose body centred, free flight, seed §2.3) or an 18-vector
+    (q, q').  ``free_decay_cm`` deflects the tip statically by that much
+    first (MODEL.md §8 free decay; implies the static start).
+    """
+    y = np.zeros(ly.N_AUG)
+    if free_decay_cm is not None:
+        _, eq = tip_load_for_deflection(p, free_decay_cm, fixed)
+        y[:ly.N_DOF] = eq.q
+        return y, (eq.contact_set, True), f"free decay from {free_decay_cm} cm"
+    if isinstance(initial, str):
+        if initial == "static":
+            eq = static_equilibrium(p, 0.0, fixed)
+            y[:ly.N_DOF] = eq.q
+            return y, (eq.contact_set, True), "static"
+        if initial == "paper":
+            return y, (0, False), "paper"
+        raise ParameterError(f"initial = {initial!r}: use 'static', 'paper' or an array of "
+                             f"{ly.N_STATE} values (q, q')")
+    arr = np.asarray(initial, dtype=float)
+    if arr.shape != (ly.N_STATE,) or not np.all(np.isfinite(arr)):
+        raise ParameterError(f"initial state must be {ly.N_STATE} finite values (q, q'), "
+                             f"got shape {arr.shape}")
+    y[:ly.N_STATE] = arr
+    return y, (0, False), "given"
+
+
+def simulate(params: Parameters, excitation: np.ndarray | None = None, duration: float = 1.0, *,
+             dt: float | None = None, output_hz: float = DEFAULT_OUTPUT_HZ, initial="static",
+             free_decay_cm: float | None = None, fixed=(), progress: bool = False) -> Run:
+    """Simulate ``duration`` seconds of the loose-joint beam (MODEL.md §3-9).
+
+    ``excitation`` is an array from :mod:`workbench.excitation` (default: none).
+    ``dt`` is the RK4 step (s), by default :func:`default_dt`.
+    ``output_hz`` is the sample rate of the signals; 1 / (output_hz dt)
+    must be a whole number.  ``fixed`` holds coordinates (tests, locked
+    joint).  Never raises on a failure of the integration: the run stops
+    with a status code and keeps what it computed.
+    """
+    if not isinstance(params, Parameters):
+        raise ParameterError(f"params must be workbench.params.Parameters, got {type(params).__name__}")
+    duration = _positive("duration", duration, "s")
+    dt = default_dt(params) if dt is None else _positive("dt", dt, "s")
+    if dt > 1e-3:
+        raise ParameterError(f"dt = {dt} s is outside the allowed range (0, 1e-3] s "
+                             "(RK4 is unstable above ~8e-5 s for these beams)")
+    output_hz = _positive("output_hz", output_hz, "Hz")
+    decim = round(1.0 / (output_hz * dt))
+    if decim < 1 or abs(decim * dt * output_hz - 1.0) > 1e-9:
+        raise ParameterError(f"output_hz = {output_hz} Hz must divide 1/dt = {1 / dt:g} Hz "
+                             "into whole steps")
+    n_steps = round(duration / dt)
+    if abs(n_steps * dt - duration) > 1e-9 * duration:
+        raise ParameterError(f"duration = {duration} s is not a whole number of steps dt = {dt} s")
+    ex = none() if excitation is None else np.asarray(excitation, dtype=float)
+    if ex.shape != (ly.N_EXC,):
+        raise ParameterError("excitation must come from workbench.excitation (an array of "
+                             f"{ly.N_EXC} values)")
+    if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
+        raise ParameterError("free_decay_cm releases the structure without excitation; "
+                             "leave excitation unset")
+    model = mdl.build(params, fixed)
+    work = mdl.make_work()
+    y, (set0, stick0), label = initial_state(params, initial, fixed, free_decay_cm)
+    try:
+        static_tip = static_equilibrium(params, 0.0, fixed).tip_y
+    except ParameterError:
+        static_tip = float("nan")
+    work.rg[ly.RG_SET] = set0
+    work.rg[ly.RG_STICK] = 1.0 if stick0 else 0.0
+    work.rg[ly.RG_SIGN] = 1.0
+    st = np.zeros(ly.N_ST)
+    chunk = max(decim, (round(_CHUNK_S / dt) // decim) * decim)
+    parts_t, parts_y, parts_s, parts_log = [], [], [], []
+    done = 0
+    status = ly.OK
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
+    t_wall = time.perf_counter()
+    while done < n_steps:
+        n = min(chunk, n_steps - done)
+        n_out = (done + n) // decim - done // decim + (1 if done == 0 else 0)
+        out_t = np.empty(n_out)
+        out_y = np.empty((n_out, ly.N_STATE))
+        out_sig = np.empty((n_out, ly.N_SIG))
+        log = np.empty((_LOG_ROWS, ly.N_LOG))
+        status, stored, n_log = run_hybrid(y, done * dt, dt, n, done, decim, *model, ex, *work,
+                                           out_t, out_y, out_sig, log, st)
+        parts_t.append(out_t[:stored])
+        parts_y.append(out_y[:stored])
+        parts_s.append(out_sig[:stored])
+        parts_log.append(log[:n_log].copy())
+        new_done = int(st[ly.ST_STEP]) if status in (ly.OK, ly.LOG_FULL) else done
+        if status == ly.OK:
+            new_done = done + n
+        if bar is not None:
+            bar.update(new_done - done)
+        y = work.stages[ly.STAGE_CUR].copy()
+        if status not in (ly.OK, ly.LOG_FULL):
+            break
+        if status == ly.LOG_FULL and new_done == done:
+            status = ly.ERR_EVENT_FLOOD
+            break
+        done = new_done
+        status = ly.OK
+    wall = time.perf_counter() - t_wall
+    if bar is not None:
+        bar.close()
+    return _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
+                     st, static_tip, label)
+
+
+def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log, st,
+              static_tip, label) -> Run:
+    t = np.concatenate(parts_t)
+    ys = np.concatenate(parts_y)
+    sig = np.concatenate(parts_s)
+    logs = np.concatenate(parts_log) if parts_log else np.empty((0, ly.N_LOG))
+    df = pd.DataFrame(ys, columns=Q_COLUMNS + QD_COLUMNS)
+    for j, name in enumerate(ly.SIGNALS):
+        df[name] = sig[:, j]
+    df["regime"] = df["regime"].astype(np.int16)
+    sets = (df["regime"].to_numpy() + 1) // 2
+    for k in range(ly.N_POINTS):
+        members = np.array([ly.SET_FIRST[s] == k or ly.SET_SECOND[s] == k for s in range(ly.N_SETS)])
+        df[f"contact{k + 1}"] = members[sets].astype(np.int8)
+    df["contact_code"] = np.array(ly.CONTACT_CODE, dtype=np.int16)[sets]
+    df.index = pd.Index(t, name="t")
+    events = pd.DataFrame({
+        "t": logs[:, ly.LOG_T],
+        "kind": pd.Categorical([ly.EVENT_KINDS[int(k)] for k in logs[:, ly.LOG_KIND]],
+                               categories=ly.EVENT_KINDS),
+        "from_regime": logs[:, ly.LOG_FROM].astype(np.int16),
+        "to_regime": logs[:, ly.LOG_TO].astype(np.int16),
+        "point": logs[:, ly.LOG_POINT].astype(np.int8),
+        **{f"impulse_n{k + 1}": logs[:, ly.LOG_P + k] for k in range(ly.N_POINTS)},
+        "impulse_t": logs[:, ly.LOG_PT],
+        "ke_lost": logs[:, ly.LOG_DKE],
+    })
+    units = {n: u for n, u in zip(ly.COORD_NAMES, ly.COORD_UNITS)}
+    units.update({f"{n}_dot": f"{u}/s" for n, u in zip(ly.COORD_NAMES, ly.COORD_UNITS)})
+    units.update(dict(zip(ly.SIGNALS, ly.SIGNAL_UNITS)))
+    units.update({"t": "s", "impulse_t": "dyn s", "ke_lost": "erg"})
+    stats = {"max_penetration_cm": max(0.0, st[ly.ST_MAX_PEN]), "max_drift_cm": st[ly.ST_MAX_DRIFT],
+             "impact_energy_lost_erg": st[ly.ST_E_IMPACT], "t_reached": st[ly.ST_T],
+             "steps": int(st[ly.ST_STEP])}
+    return Run(params=params, excitation=ex, dt=dt, duration=duration, status=int(status),
+               message=ly.MESSAGES[int(status)], wall_s=wall, signals=df, events=events,
+               stats=stats, static_tip_y=static_tip, initial=label, units=units)
