@@ -236,6 +236,16 @@ class Parameters:
 FIELDS = {f.name: f for f in dataclasses.fields(Parameters)}
 
 
+def check_positive(name: str, value, unit: str, allow_zero: bool = False) -> float:
+    """``value`` as a float if it is a finite number > 0 (>= 0 with allow_zero), else
+    a ParameterError naming the parameter and the allowed range."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    if not ok or value < 0 or (value == 0 and not allow_zero):
+        allowed = "[0, inf)" if allow_zero else "(0, inf)"
+        raise ParameterError(f"{name} = {value!r} {unit} is outside the allowed range {allowed} {unit}")
+    return float(value)
+
+
 def _to_cgs(values: dict[str, Any]) -> dict[str, Any]:
     """Map user names (possibly unit-suffixed) to CGS field names and values."""
     out: dict[str, Any] = {}

@@ -13,7 +13,6 @@ Units are CGS (MODEL.md); ``run.units`` names them per column.
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
@@ -24,7 +23,7 @@ from . import model as mdl
 from .core import layout as ly
 from .core.hybrid import run_hybrid
 from .excitation import none
-from .params import ParameterError, Parameters
+from .params import ParameterError, Parameters, check_positive
 from .statics import static_equilibrium, tip_load_for_deflection
 
 #: Steps :func:`default_dt` chooses from (s): each divides 1 ms.
@@ -170,15 +169,12 @@ def regime_name(regime: int) -> str:
     return f"{'stick' if regime % 2 else 'slip'} {{{','.join(code)}}}"
 
 
-def _positive(name, value, unit):
-    if not (isinstance(value, (int, float)) and not isinstance(value, bool)
-            and math.isfinite(value) and value > 0):
-        raise ParameterError(f"{name} = {value!r} {unit} is outside the allowed range (0, inf) {unit}")
-    return float(value)
-
-
-def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: float | None = None):
+def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: float | None = None,
+                  static=None):
     """The augmented initial state (N_AUG,), its regime (set, stick) and a label.
+
+    ``static`` is the gravity equilibrium if already solved (it is not
+    solved again).
 
     ``initial``: "static" (equilibrium under gravity), "paper" (undeformed,
     at rest, loose body centred, free flight, seed §2.3) or an 18-vector
@@ -187,12 +183,12 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
     """
     y = np.zeros(ly.N_AUG)
     if free_decay_cm is not None:
-        _, eq = tip_load_for_deflection(p, free_decay_cm, fixed)
+        _, eq = tip_load_for_deflection(p, free_decay_cm, fixed, base=static)
         y[:ly.N_DOF] = eq.q
         return y, (eq.contact_set, True), f"free decay from {free_decay_cm} cm"
     if isinstance(initial, str):
         if initial == "static":
-            eq = static_equilibrium(p, 0.0, fixed)
+            eq = static_equilibrium(p, 0.0, fixed) if static is None else static
             y[:ly.N_DOF] = eq.q
             return y, (eq.contact_set, True), "static"
         if initial == "paper":
@@ -221,12 +217,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     """
     if not isinstance(params, Parameters):
         raise ParameterError(f"params must be workbench.params.Parameters, got {type(params).__name__}")
-    duration = _positive("duration", duration, "s")
-    dt = default_dt(params) if dt is None else _positive("dt", dt, "s")
+    duration = check_positive("duration", duration, "s")
+    dt = default_dt(params) if dt is None else check_positive("dt", dt, "s")
     if dt > 1e-3:
         raise ParameterError(f"dt = {dt} s is outside the allowed range (0, 1e-3] s "
                              "(RK4 is unstable above ~8e-5 s for these beams)")
-    output_hz = _positive("output_hz", output_hz, "Hz")
+    output_hz = check_positive("output_hz", output_hz, "Hz")
     decim = round(1.0 / (output_hz * dt))
     if decim < 1 or abs(decim * dt * output_hz - 1.0) > 1e-9:
         raise ParameterError(f"output_hz = {output_hz} Hz must divide 1/dt = {1 / dt:g} Hz "
@@ -243,11 +239,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
                              "leave excitation unset")
     model = mdl.build(params, fixed)
     work = mdl.make_work()
-    y, (set0, stick0), label = initial_state(params, initial, fixed, free_decay_cm)
     try:
-        static_tip = static_equilibrium(params, 0.0, fixed).tip_y
+        static = static_equilibrium(params, 0.0, fixed)     # the tip's reference position
     except ParameterError:
-        static_tip = float("nan")
+        static = None
+    y, (set0, stick0), label = initial_state(params, initial, fixed, free_decay_cm, static)
+    static_tip = float("nan") if static is None else static.tip_y
     work.rg[ly.RG_SET] = set0
     work.rg[ly.RG_STICK] = 1.0 if stick0 else 0.0
     work.rg[ly.RG_SIGN] = 1.0

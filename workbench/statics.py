@@ -29,7 +29,7 @@ import numpy as np
 from . import model as mdl
 from .core import layout as ly
 from .core.contact import eval_geometry
-from .core.dynamics import eval_rhs
+from .core.dynamics import energies, eval_rhs
 from .core.kinematics import element_kinematics
 from .excitation import DYN_PER_N, none
 from .params import ParameterError, Parameters
@@ -90,7 +90,6 @@ class _Statics:
         return self._cg[:, ly.CG_VAL].copy(), grad.copy()
 
     def potential(self, q):
-        from .core.dynamics import energies
         out = np.zeros(4)
         energies(np.concatenate([q, np.zeros(ly.N_DOF)]), *self.model, *self.work, out)
         _, tip_y = self.force(q)
@@ -212,13 +211,15 @@ def static_equilibrium(p: Parameters, tip_load_n: float = 0.0, fixed=(), s0: flo
                          f"(tip load {tip_load_n} N); check gap, h4 and the loads")
 
 
-def tip_load_for_deflection(p: Parameters, deflection_cm: float, fixed=()) -> tuple[float, Equilibrium]:
+def tip_load_for_deflection(p: Parameters, deflection_cm: float, fixed=(),
+                            base: Equilibrium | None = None) -> tuple[float, Equilibrium]:
     """The vertical tip load (N) that moves the tip by ``deflection_cm`` from its
-    gravity equilibrium (+ up), and that equilibrium (secant iteration to 1e-6 cm)."""
+    gravity equilibrium ``base`` (+ up; solved if not given), and that
+    equilibrium (secant iteration to 1e-6 cm)."""
     if not (np.isfinite(deflection_cm) and abs(deflection_cm) <= 20.0):
         raise ParameterError(f"deflection_cm = {deflection_cm!r} cm is outside the allowed "
                              "range [-20, 20] cm")
-    base = static_equilibrium(p, 0.0, fixed)
+    base = static_equilibrium(p, 0.0, fixed) if base is None else base
     if deflection_cm == 0.0:
         return 0.0, base
     target = base.tip_y + deflection_cm

@@ -41,6 +41,20 @@ from .dynamics import rhs, solve_factored
 
 
 @nb.njit(**JIT_INLINE)
+def _put_row(cw, r, cg, geometry_row, friction_row, friction):
+    """Constraint row r: A = d(geometry_row)/dq, B = A + friction d(friction_row)/dq."""
+    a = cw[ly.CW_A + r]
+    b = cw[ly.CW_B + r]
+    for j in range(ly.N_DOF):
+        a[j] = 0.0
+        b[j] = 0.0
+    row_to_dof(cg, geometry_row, 1.0, a)
+    row_to_dof(cg, geometry_row, 1.0, b)
+    if friction != 0.0:
+        row_to_dof(cg, friction_row, friction, b)
+
+
+@nb.njit(**JIT_INLINE)
 def set_rows(set_index, stick, sign, tpt, P, cg, cw):
     """Rows A and force directions B (9-vectors) of a regime into cw; return their number.
 
@@ -48,30 +62,15 @@ def set_rows(set_index, stick, sign, tpt, P, cg, cw):
     when sticking, the tangential row of the point ``tangent_point(set_index, tpt)``.
     """
     m = 0
-    mu_k = P[ly.P_MU_K]
+    friction = 0.0 if stick else -P[ly.P_MU_K] * sign
+    tangent = ly.CG_T + tangent_point(set_index, tpt)
     for which in range(2):
         p = ly.SET_FIRST[set_index] if which == 0 else ly.SET_SECOND[set_index]
-        if p < 0:
-            continue
-        a = cw[ly.CW_A + m]
-        b = cw[ly.CW_B + m]
-        for j in range(ly.N_DOF):
-            a[j] = 0.0
-            b[j] = 0.0
-        row_to_dof(cg, ly.CG_G + p, 1.0, a)
-        row_to_dof(cg, ly.CG_G + p, 1.0, b)
-        if not stick:
-            row_to_dof(cg, ly.CG_T + tangent_point(set_index, tpt), -mu_k * sign, b)
-        m += 1
+        if p >= 0:
+            _put_row(cw, m, cg, ly.CG_G + p, tangent, friction)
+            m += 1
     if stick:
-        p = tangent_point(set_index, tpt)
-        a = cw[ly.CW_A + m]
-        b = cw[ly.CW_B + m]
-        for j in range(ly.N_DOF):
-            a[j] = 0.0
-            b[j] = 0.0
-        row_to_dof(cg, ly.CG_T + p, 1.0, a)
-        row_to_dof(cg, ly.CG_T + p, 1.0, b)
+        _put_row(cw, m, cg, tangent, tangent, 0.0)
         m += 1
     return m
 
