@@ -197,16 +197,21 @@ class Reference:
         n, k, c = self.p.cork_law
         return k * np.sign(s) * abs(s) ** n + c * sd
 
-    def accelerations(self, t, q, qd):
+    def generalized(self, t, q, qd):
+        """M and the generalized force Q - h (applied, elastic, damping, cork, inertial)."""
         M, h, Q, _ = self.inertia(q, qd)
         Q = Q - self.K @ q - self.C @ qd
         Q[3] -= self.cork(q[3], qd[3])
         # shaker: the vertical force at force1 does work F dy
         _, yf, _ = beam_point(q, qd, 0, np.array([self.p.x_force / self.p.l_a]), self.p.l_a, 0.0)
         Q += self.excitation(t) * yf.g[0]
+        return M, Q - h
+
+    def accelerations(self, t, q, qd):
+        M, F = self.generalized(t, q, qd)
         f = self.free
         qdd = np.zeros(N)
-        qdd[f] = np.linalg.solve(M[np.ix_(f, f)], (Q - h)[f])
+        qdd[f] = np.linalg.solve(M[np.ix_(f, f)], F[f])
         return qdd
 
     def rhs(self, t, y):

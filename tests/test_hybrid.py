@@ -202,22 +202,27 @@ def test_energy_balance_closes_at_a_fine_step():
 
 
 def test_halving_the_step_reduces_the_error_eightfold():
-    """0.1 s from the paper's start, 18 events (impacts, stick/slip, separations).
+    """0.1 s from the paper's start, 17 events (impacts, stick/slip, separations).
 
-    Velocities and the energy balance converge at RK4's order through the
-    events (measured ratios ~15); positions only at ~3-5 (see README).
+    Positions, velocities and the energy balance converge at RK4's order
+    through the events (measured ratios 12-17 per halving).
     """
     p = Parameters()
     runs = {dt: simulate(p, None, 0.1, dt=dt, initial="paper") for dt in (5e-5, 2.5e-5, 1.25e-5)}
     n_events = {dt: len(r.events) for dt, r in runs.items()}
     assert len(set(n_events.values())) == 1 and n_events[5e-5] >= 10     # the same events
     ref = runs[1.25e-5]
-    for col in ("w_B_dot", "v_dot", "psi_dot"):
+    for col in ("w_B", "s", "v", "psi", "w_B_dot", "s_dot", "v_dot", "psi_dot"):
         err = [np.abs(runs[dt].signals[col] - ref.signals[col]).max() for dt in (5e-5, 2.5e-5)]
         assert err[1] > 0 and err[0] / err[1] >= 8.0, (col, err)
     bal = [runs[dt].summary()["energy_balance_rel"] for dt in (5e-5, 2.5e-5)]
     assert bal[0] / bal[1] >= 8.0
-    assert np.abs(runs[5e-5].events.t.to_numpy() - ref.events.t.to_numpy()).max() < 1e-6
+    t_err = [np.abs(runs[dt].events.t.to_numpy() - ref.events.t.to_numpy()).max()
+             for dt in (5e-5, 2.5e-5)]
+    # event times: within 1e-7 s at the default step, and shrinking; the
+    # slip -> stick times converge irregularly (error terms of opposite sign,
+    # measured against dt/32: -9.5e-9, 3.2e-9, 4.1e-10 s), the others ~16-fold
+    assert t_err[0] < 1e-7 and t_err[1] < t_err[0], t_err
 
 
 def test_every_regime_is_reached():
