@@ -8,7 +8,7 @@ p = Parameters()
 runs = {dt: simulate(p, None, 0.1, dt=dt, initial="paper") for dt in (5e-5, 2.5e-5, 1.25e-5, 6.25e-6, 5e-6)}
 print("events", {dt: len(r.events) for dt, r in runs.items()})
 ref = runs[1.25e-5]
-for col in ("w_B", "w_B_dot", "v_dot", "psi"):
+for col in ("w_B", "s", "v", "psi", "w_B_dot", "s_dot", "v_dot", "psi_dot"):
     e = [np.abs(runs[dt].signals[col] - ref.signals[col]).max() for dt in (5e-5, 2.5e-5)]
     print(col, e, "ratio", e[0] / e[1])
 print("event t diff", np.abs(runs[5e-5].events.t.to_numpy() - ref.events.t.to_numpy()).max())
