@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from . import __version__
 from .params import CORK_MODELS, ParameterError, Parameters, describe
@@ -137,6 +138,22 @@ def _cmd_params(args) -> int:
     return 0
 
 
+def _cmd_sweep(args) -> int:
+    from .study import load
+    from .sweep import run_study
+
+    study = load(args.study)
+    if args.jobs < 1:
+        raise ParameterError(f"--jobs = {args.jobs} must be at least 1")
+    table = run_study(study, args.results, jobs=args.jobs, scheduler=args.scheduler,
+                      fresh=args.fresh, progress=not args.quiet)
+    counts = table.status.value_counts().to_dict() if len(table) else {}
+    print(json.dumps({"study": study.name, "points": study.n_points,
+                      "status": {str(k): int(v) for k, v in counts.items()},
+                      "results": str(Path(args.results) / study.name)}))
+    return 0 if counts.get("ok", 0) == study.n_points else 1
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="workbench", description="Loose bolted lap joint workbench (9-DOF Gibbs-Appell model).")
@@ -174,6 +191,16 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", metavar="FILE.parquet", help="write the signals (and events) to Parquet")
     run.add_argument("--json", action="store_true", help="print one JSON object")
     run.set_defaults(func=_cmd_run)
+
+    sweep = sub.add_parser("sweep", help="run a study's grid (TOML) in parallel, resumably")
+    sweep.add_argument("study", help="study definition, e.g. studies/default.toml")
+    sweep.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
+    sweep.add_argument("--scheduler", default=None,
+                       help="Dask scheduler address (tcp://host:port): run on that cluster")
+    sweep.add_argument("--fresh", action="store_true", help="discard finished points first")
+    sweep.add_argument("--results", default="results", help="results root (default results/)")
+    sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.set_defaults(func=_cmd_sweep)
 
     params = sub.add_parser("params", help="list every parameter with its unit, range and source")
     _add_model_options(params)

@@ -250,18 +250,7 @@ def _to_cgs(values: dict[str, Any]) -> dict[str, Any]:
     """Map user names (possibly unit-suffixed) to CGS field names and values."""
     out: dict[str, Any] = {}
     for key, value in values.items():
-        name, factor = key, 1.0
-        if key not in FIELDS:
-            for suffix, (unit, f) in USER_UNITS.items():
-                stem = key[: -len(suffix)]
-                if key.endswith(suffix) and stem in FIELDS and FIELDS[stem].metadata["unit"] == unit:
-                    name, factor = stem, f
-                    break
-            else:
-                close = difflib.get_close_matches(key, list(FIELDS) + _suffixed_names(), n=3)
-                hint = f"; did you mean {', '.join(close)}?" if close else ""
-                raise ParameterError(f"unknown parameter {key!r}{hint} "
-                                     f"(see `workbench params` for the list)")
+        name, factor = resolve_name(key)
         if name in out:
             raise ParameterError(f"parameter {name!r} given twice (as {key!r})")
         if factor != 1.0:
@@ -275,6 +264,22 @@ def _to_cgs(values: dict[str, Any]) -> dict[str, Any]:
             value = value * factor
         out[name] = value
     return out
+
+
+def resolve_name(key: str) -> tuple[str, float]:
+    """(CGS field name, factor to CGS) of a user name such as 'gap_mm' or 'gap'.
+
+    Raises ParameterError, with close matches, for an unknown name.
+    """
+    if key in FIELDS:
+        return key, 1.0
+    for suffix, (unit, f) in USER_UNITS.items():
+        stem = key[: -len(suffix)]
+        if key.endswith(suffix) and stem in FIELDS and FIELDS[stem].metadata["unit"] == unit:
+            return stem, f
+    close = difflib.get_close_matches(key, list(FIELDS) + _suffixed_names(), n=3)
+    hint = f"; did you mean {', '.join(close)}?" if close else ""
+    raise ParameterError(f"unknown parameter {key!r}{hint} (see `workbench params` for the list)")
 
 
 def _suffixed_names() -> list[str]:

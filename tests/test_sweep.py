@@ -1,0 +1,186 @@
+"""Studies and sweeps (issue 4): definition -> parallel, resumable runs -> points table."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from workbench import study as S
+from workbench import sweep as W
+from workbench.params import ParameterError
+
+SMALL = """
+[study]
+name = "small"
+duration_s = 0.5
+window_s = 0.2
+save_series = [{gap_mm = 1.016, freq_hz = 20.0}]
+
+[excitation]
+kind = "sine"
+force_n = 20.0
+ramp_s = 0.1
+
+[axes]
+gap_mm = [0.508, 1.016]
+freq_hz = [20.0, 30.0]
+"""
+
+
+def write(tmp_path, text, name="study.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def comparable(table):
+    """The table without what legitimately differs between runs (wall time)."""
+    return table.drop(columns=["wall_s"]).sort_values("key").reset_index(drop=True)
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    root = tmp_path_factory.mktemp("sweep")
+    study = S.load(write(root, SMALL))
+    return study, root, W.run_study(study, root / "res1", jobs=1, progress=False)
+
+
+def test_small_grid_end_to_end(small_run):
+    study, root, table = small_run
+    assert study.n_points == 4 and len(table) == 4
+    assert (table.status == "ok").all()
+    assert sorted(zip(table.axis_gap_mm, table.axis_freq_hz)) == \
+        [(0.508, 20.0), (0.508, 30.0), (1.016, 20.0), (1.016, 30.0)]
+    # the fit recovers the drive: 20 N = 2e6 dyn at f, nothing at f/2 in the force
+    assert np.allclose(table["force1_h1"], 2e6, rtol=1e-9)
+    assert (table["force1_h0.5"] < 1e-6 * 2e6).all()
+    shares = table[[c for c in table if c.startswith("share_")]].sum(axis=1)
+    assert np.allclose(shares, 1.0, atol=1e-12)
+    assert (table.tip_rms > 0).all() and table.steady.dtype == bool
+    on_disk = pd.read_parquet(root / "res1" / "small" / "points.parquet")
+    pd.testing.assert_frame_equal(on_disk, table)
+    series = sorted(p.name for p in (root / "res1" / "small" / "series").iterdir())
+    assert len(series) == 2          # one named point: signals + events
+    key = table[(table.axis_gap_mm == 1.016) & (table.axis_freq_hz == 20.0)].key.iloc[0]
+    assert series == [f"{key}.events.parquet", f"{key}.parquet"]
+
+
+def test_two_workers_give_the_same_results_to_the_bit(small_run):
+    study, root, table = small_run
+    table2 = W.run_study(study, root / "res2", jobs=2, progress=False)
+    pd.testing.assert_frame_equal(comparable(table), comparable(table2), check_exact=True)
+
+
+def test_rerun_skips_finished_points_and_recomputes_a_missing_one(small_run, tmp_path):
+    study, root, table = small_run
+    res = tmp_path / "res"
+    W.run_study(study, res, jobs=1, progress=False)
+    files = sorted((res / "small" / "points").glob("*.parquet"))
+    stamps = {f: f.stat().st_mtime_ns for f in files}
+    files[0].unlink()
+    again = W.run_study(study, res, jobs=1, progress=False)
+    assert files[0].exists()
+    assert all(f.stat().st_mtime_ns == stamps[f] for f in files[1:])
+    pd.testing.assert_frame_equal(comparable(again), comparable(table), check_exact=True)
+
+
+def test_a_killed_sweep_resumes(small_run, tmp_path):
+    """kill -9 the CLI after its first point is on disk; a rerun completes the grid."""
+    study, root, table = small_run
+    res = tmp_path / "res"
+    cmd = [sys.executable, "-m", "workbench", "sweep", study.source, "--jobs", "1",
+           "--results", str(res), "--quiet"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    points = res / "small" / "points"
+    deadline = time.time() + 600
+    while time.time() < deadline and not (points.exists() and any(points.glob("*.parquet"))):
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    done = list(points.glob("*.parquet"))
+    assert 1 <= len(done) < 4, "the kill should land mid-sweep"
+    resumed = W.run_study(study, res, jobs=1, progress=False)
+    pd.testing.assert_frame_equal(comparable(resumed), comparable(table), check_exact=True)
+
+
+def test_a_failing_point_is_recorded_and_the_sweep_goes_on(small_run, tmp_path, monkeypatch):
+    study, _, _ = small_run
+    real = W.simulate
+
+    def flaky(params, excitation, *args, **kwargs):
+        if excitation[2] == 30.0 and params.gap > 0.1:         # X_FREQ; the 1.016 mm gap
+            raise RuntimeError("injected failure")
+        return real(params, excitation, *args, **kwargs)
+
+    monkeypatch.setattr(W, "simulate", flaky)
+    table = W.run_study(study, tmp_path / "res", jobs=1, progress=False)
+    bad = table[table.status != "ok"]
+    assert len(bad) == 1 and len(table) == 4
+    assert bad.status.iloc[0] == "error" and "injected failure" in bad.message.iloc[0]
+    assert "RuntimeError" in bad.traceback.iloc[0]
+
+
+def test_an_unstable_point_is_recorded_as_failed(tmp_path):
+    text = SMALL.replace("window_s = 0.2", "window_s = 0.2\ndt = 1e-3\noutput_hz = 1000.0")
+    text = text.replace("gap_mm = [0.508, 1.016]", "gap_mm = [1.016]").replace(
+        "freq_hz = [20.0, 30.0]", "freq_hz = [20.0]")
+    table = W.run_study(S.load(write(tmp_path, text)), tmp_path / "res", jobs=1, progress=False)
+    assert table.status.tolist() == ["failed"]
+    assert table.message.iloc[0]
+
+
+def test_stepped_sweep_carries_the_state(tmp_path):
+    text = SMALL.replace('window_s = 0.2', 'window_s = 0.2\nsweep = "up-down"').replace(
+        "freq_hz = [20.0, 30.0]", "freq_hz = [20.0, 25.0, 30.0]").replace(
+        "gap_mm = [0.508, 1.016]", "gap_mm = [1.016]")
+    study = S.load(write(tmp_path, text))
+    chain = study.chains()[0]
+    assert [p.values["freq_hz"] for p in chain] == [20.0, 25.0, 30.0, 25.0, 20.0]
+    assert [p.direction for p in chain] == ["up"] * 3 + ["down"] * 2
+    table = W.run_study(study, tmp_path / "res", jobs=1, progress=False)
+    assert (table.status == "ok").all() and len(table) == 5
+    assert table.sort_values("step").continued.tolist() == [False, True, True, True, True]
+    assert len(set(table.key)) == 5      # 25 Hz up and down are different points
+
+
+@pytest.mark.parametrize("edit, message", [
+    (("[axes]", "[axis]"), "unknown table"),
+    (('name = "small"', 'name = "small"\nlength = 3'), "unknown key(s) ['length']"),
+    (("gap_mm = [0.508, 1.016]", "gapp_mm = [0.508]"), "did you mean gap_mm"),
+    (("gap_mm = [0.508, 1.016]", "gap_mm = [0.508, 6.0]"), "gap_mm = 6.0 mm is outside"),
+    (("force_n = 20.0", "force_n = 20.0\nf0_hz = 5.0"), "does not apply to a 'sine'"),
+    (("window_s = 0.2", "window_s = 0.4"), "at most half of duration_s"),
+    (("window_s = 0.2", 'window_s = 0.2\nsweep = "sideways"'), "sweep = 'sideways'"),
+    (("ramp_s = 0.1", "ramp_s = -1.0"), "ramp_s"),
+    (("freq_hz = [20.0, 30.0]", "freq_hz = [20.0, 20.0]"), "lists a value twice"),
+    (("[axes]", "[fixed]\ngap_mm = 1.0\n[axes]"), "both as an axis and as a fixed value"),
+])
+def test_bad_study_files_are_rejected_before_running(tmp_path, edit, message):
+    text = SMALL.replace(*edit)
+    assert text != SMALL
+    with pytest.raises(ParameterError) as err:
+        S.load(write(tmp_path, text))
+    assert message in str(err.value)
+    assert str(tmp_path) in str(err.value)      # names the file
+
+
+def test_cli_sweep_rejects_a_bad_file(tmp_path, capsys):
+    from workbench.cli import main
+    assert main(["sweep", str(write(tmp_path, SMALL.replace("[axes]", "[axis]")))]) == 2
+    assert "unknown table" in capsys.readouterr().err
+
+
+def test_dask_cluster_gives_the_local_results(small_run, tmp_path):
+    import distributed       # a dev dependency: the Dask path is always tested
+    study, _, table = small_run
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1",
+                                  dashboard_address=None, processes=True) as cluster:
+        remote = W.run_study(study, tmp_path / "res", scheduler=cluster.scheduler_address,
+                             progress=False)
+    pd.testing.assert_frame_equal(comparable(remote), comparable(table), check_exact=True)

@@ -1,0 +1,107 @@
+"""Scalar results of one run over its steady-state window (issue 4).
+
+The window is the last ``window_s`` seconds of the run.  Per sensor channel
+(force1, strain1, strain2, accel1-3) and for the tip displacement from its
+static equilibrium (``tip``, cm):
+
+    <ch>_rms    RMS about the window mean (the dynamic part; strains carry a
+                static part under gravity)
+    <ch>_peak   largest |x - mean| in the window
+    <ch>_h0.5, <ch>_h1, <ch>_h2, <ch>_h3
+                amplitudes of the harmonics f/2, f, 2f, 3f of the drive
+                frequency f (sine runs), by a least-squares fit of the
+                window to a constant and those four sinusoids
+
+Contact statistics from the event log (exact times, not samples):
+``share_<code>`` the fraction of the window in each contact code (0, 1, 2,
+3, 4, 13, 14, 23, 24), ``stick_share`` the fraction in a sticking regime,
+``impacts_per_s`` and ``switches_per_s`` (every event).  Energy dissipated
+per forcing cycle (erg; per second without a drive frequency) by structural
+damping, cork damping, friction and impacts: ``diss_<mechanism>``.
+
+Steady-state indicator (the first mode, ~2 Hz with zeta < 1 %, rings for
+tens of seconds): ``steady_change`` = |RMS_last - RMS_previous| / RMS_last
+of the tip displacement over the last two windows; ``steady`` is
+``steady_change <= steady_tol``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .core import layout as ly
+
+CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
+HARMONICS = (0.5, 1.0, 2.0, 3.0)
+CONTACT_CODES = tuple(int(c) for c in ly.CONTACT_CODE)
+DISSIPATION = {"structural": "d_structural", "cork": "d_cork", "friction": "d_friction",
+               "impact": "d_impact"}
+#: Default bound on the relative RMS change between the last two windows.
+STEADY_TOL = 0.05
+
+
+def harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> dict[float, float]:
+    """Amplitudes of x at k f_hz (k in HARMONICS) by least squares with a constant term."""
+    cols = [np.ones_like(t)]
+    for k in HARMONICS:
+        w = 2.0 * np.pi * k * f_hz
+        cols += [np.cos(w * t), np.sin(w * t)]
+    coef, *_ = np.linalg.lstsq(np.column_stack(cols), x, rcond=None)
+    return {k: float(np.hypot(coef[1 + 2 * i], coef[2 + 2 * i])) for i, k in enumerate(HARMONICS)}
+
+
+def regime_time(events, t0: float, t1: float) -> dict[int, float]:
+    """Time (s) spent in each regime within [t0, t1], from the event log."""
+    times = events.t.to_numpy()
+    regimes = events.to_regime.to_numpy()
+    out: dict[int, float] = {}
+    for k in range(len(times)):
+        start = max(times[k], t0)
+        end = min(times[k + 1] if k + 1 < len(times) else t1, t1)
+        if end > start:
+            out[int(regimes[k])] = out.get(int(regimes[k]), 0.0) + end - start
+    return out
+
+
+def point_metrics(run, window_s: float, drive_hz: float | None = None,
+                  steady_tol: float = STEADY_TOL) -> dict:
+    """The metrics of the module docstring for a finished :class:`~workbench.simulate.Run`."""
+    sig = run.signals
+    t = sig.index.to_numpy()
+    t_end = float(t[-1])
+    t0 = t_end - window_s
+    win = t >= t0 - 1e-12
+    prev = (t >= t0 - window_s - 1e-12) & (t < t0 - 1e-12)
+    out: dict = {}
+    tip = (sig.tip_y - run.static_tip_y).to_numpy()
+    data = {ch: (tip if ch == "tip" else sig[ch].to_numpy()) for ch in CHANNELS}
+    for ch, x in data.items():
+        xw = x[win]
+        dev = xw - xw.mean()
+        out[f"{ch}_rms"] = float(np.sqrt(np.mean(dev ** 2)))
+        out[f"{ch}_peak"] = float(np.abs(dev).max())
+        if drive_hz:
+            for k, a in harmonic_amplitudes(t[win], xw, drive_hz).items():
+                out[f"{ch}_h{k:g}"] = a
+    rms_prev = float(np.std(tip[prev])) if prev.sum() > 1 else float("nan")
+    rms_last = out["tip_rms"]
+    change = abs(rms_last - rms_prev) / rms_last if rms_last > 0 else 0.0
+    out["steady_change"] = float(change)
+    out["steady"] = bool(change <= steady_tol)
+    spent = regime_time(run.events, t0, t_end)
+    total = sum(spent.values()) or 1.0
+    for code in CONTACT_CODES:
+        out[f"share_{code}"] = 0.0
+    stick = 0.0
+    for reg, dur in spent.items():
+        out[f"share_{ly.CONTACT_CODE[(reg + 1) // 2]}"] += dur / total
+        if reg % 2 == 1:
+            stick += dur / total
+    out["stick_share"] = stick
+    ev = run.events[(run.events.t >= t0) & (run.events.kind != "start")]
+    out["impacts_per_s"] = float((ev.kind == "impact").sum() / window_s)
+    out["switches_per_s"] = float(len(ev) / window_s)
+    cycles = window_s * drive_hz if drive_hz else window_s
+    for name, col in DISSIPATION.items():
+        x = sig[col].to_numpy()
+        out[f"diss_{name}"] = float((x[-1] - x[win][0]) / cycles)
+    return out

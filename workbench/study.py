@@ -1,0 +1,276 @@
+"""Study definitions: a grid of simulations described once in a TOML file.
+
+    [study]
+    name = "shaker"                  # results go to results/<name>/
+    duration_s = 10.0                # simulated time per point (s)
+    window_s = 2.0                   # steady-state window at the end of each point (s)
+    sweep = "independent"            # or "up", "down", "up-down" (stepped frequency sweeps)
+    dt = 5e-5                        # optional RK4 step (s); default: simulate.default_dt
+    output_hz = 1000.0               # optional sample rate of the signals (Hz)
+    save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
+
+    [excitation]
+    kind = "sine"                    # sine | chirp | free_decay | hammer_joint | hammer_tip | none
+    force_n = 20.0
+    ramp_s = 1.0                     # soft start (s)
+
+    [fixed]                          # any model parameter (workbench params), unit suffixes allowed
+    mu_s = 0.3
+
+    [axes]                           # the grid: any model or excitation parameter, lists of values
+    gap_mm = [0.508, 1.016]
+    freq_hz = [10.0, 20.0, 30.0]
+    tip_mass = [true, false]
+
+Every key is checked before anything runs (:func:`load`), and every grid
+point's model parameters and excitation are built once, so a bad value is
+reported with the parameter's allowed range, not halfway through a sweep.
+
+A stepped sweep (``sweep = "up"`` etc.) runs each frequency from the final
+state of the previous one, all other axes equal; the soft start applies to
+the first frequency only.  ``up-down`` runs the frequencies up and then down
+again, so that hysteresis and jumps of the nonlinear response show.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from . import excitation as X
+from .params import ParameterError, Parameters, check_positive, resolve_name
+
+#: Excitation kinds and the keys each accepts (user units in the names).
+EXCITATION_KEYS = {
+    "none": (),
+    "sine": ("force_n", "freq_hz", "ramp_s"),
+    "chirp": ("force_n", "f0_hz", "f1_hz", "sweep_s", "ramp_s"),
+    "free_decay": ("deflection_cm",),
+    "hammer_joint": ("force_n", "width_s", "t_hit_s"),
+    "hammer_tip": ("force_n", "width_s", "t_hit_s"),
+}
+EXCITATION_DEFAULTS = {"force_n": X.DEFAULT_FORCE_N, "ramp_s": 0.0, "width_s": 1e-3,
+                       "t_hit_s": 0.0, "deflection_cm": 8.4}
+ALL_EXCITATION_KEYS = sorted({k for keys in EXCITATION_KEYS.values() for k in keys})
+SWEEP_MODES = ("independent", "up", "down", "up-down")
+STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz",
+              "save_series", "initial"}
+
+
+class StudyError(ParameterError):
+    """A study file that cannot run (names the file, the key and what is allowed)."""
+
+
+@dataclass(frozen=True)
+class Point:
+    """One grid point: its axis values, the model parameters and the excitation settings."""
+
+    values: dict            # axis name -> value (user units), in axis order
+    params: Parameters
+    excitation: dict        # kind and its settings (user units)
+    chain: int = 0          # stepped sweeps: the points of one chain share all but freq_hz
+    step: int = 0           # position within the chain
+    direction: str = ""     # "up" or "down" in a stepped sweep
+
+    def excitation_array(self, first_in_chain: bool = True) -> np.ndarray:
+        """The kernel's excitation array (the soft start only on a chain's first point)."""
+        e = dict(self.excitation)
+        kind = e.pop("kind")
+        if kind in ("sine", "chirp") and not first_in_chain:
+            e["ramp_s"] = 0.0
+        if kind == "none" or kind == "free_decay":
+            return X.none()
+        if kind == "sine":
+            return X.sine(e["force_n"], e["freq_hz"], e["ramp_s"])
+        if kind == "chirp":
+            return X.chirp(e["force_n"], e["f0_hz"], e["f1_hz"], e["sweep_s"], e["ramp_s"])
+        builder = X.hammer_joint if kind == "hammer_joint" else X.hammer_tip
+        return builder(e["force_n"], e["width_s"], e["t_hit_s"])
+
+    @property
+    def free_decay_cm(self):
+        return self.excitation.get("deflection_cm") if self.excitation["kind"] == "free_decay" \
+            else None
+
+    @property
+    def drive_hz(self):
+        """The forcing frequency (Hz) of a sine, else None."""
+        return self.excitation.get("freq_hz") if self.excitation["kind"] == "sine" else None
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study definition (see the module docstring for the file format)."""
+
+    name: str
+    description: str
+    duration_s: float
+    window_s: float
+    sweep: str
+    dt: float | None
+    output_hz: float
+    initial: str
+    excitation: dict
+    fixed: dict
+    axes: dict
+    save_series: tuple = ()
+    source: str = ""
+    points: tuple = field(default=(), repr=False)
+
+    @property
+    def n_points(self) -> int:
+        return len(self.points)
+
+    def chains(self) -> list[list[Point]]:
+        """Points grouped into the sequences that run one after another (stepped sweeps),
+        or one point per group (independent)."""
+        groups: dict[int, list[Point]] = {}
+        for p in self.points:
+            groups.setdefault(p.chain, []).append(p)
+        return [sorted(g, key=lambda p: p.step) for g in groups.values()]
+
+    def saves_series(self, point: Point) -> bool:
+        return any(all(_same(point.values.get(k, point.excitation.get(k)), v)
+                       for k, v in sel.items()) for sel in self.save_series)
+
+
+def _same(a, b):
+    if isinstance(a, float) or isinstance(b, float):
+        try:
+            return math.isclose(float(a), float(b), rel_tol=1e-12)
+        except (TypeError, ValueError):
+            return False
+    return a == b
+
+
+def load(path: str | Path) -> Study:
+    """Read and validate a study file; raises StudyError naming what is wrong."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"{path}: not valid TOML: {exc}") from None
+    except OSError as exc:
+        raise StudyError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        return from_dict(data, source=str(path))
+    except ParameterError as exc:
+        raise StudyError(f"{path}: {exc}") from None
+
+
+def from_dict(data: dict[str, Any], source: str = "") -> Study:
+    """A Study from the parsed TOML tables (see the module docstring)."""
+    unknown = sorted(set(data) - {"study", "excitation", "fixed", "axes"})
+    if unknown:
+        raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [fixed], [axes]")
+    head = dict(data.get("study", {}))
+    bad = sorted(set(head) - STUDY_KEYS)
+    if bad:
+        raise StudyError(f"unknown key(s) {bad} in [study]; allowed: {sorted(STUDY_KEYS)}")
+    name = head.get("name")
+    if not isinstance(name, str) or not name or not all(c.isalnum() or c in "-_" for c in name):
+        raise StudyError(f"[study] name = {name!r} must be a non-empty word of letters, "
+                         "digits, '-' and '_' (it names results/<name>/)")
+    duration = check_positive("[study] duration_s", head.get("duration_s"), "s")
+    window = check_positive("[study] window_s", head.get("window_s", min(2.0, duration / 2)), "s")
+    if window > duration / 2:
+        raise StudyError(f"[study] window_s = {window} s must be at most half of duration_s = "
+                         f"{duration} s (two windows give the steady-state indicator)")
+    sweep = head.get("sweep", "independent")
+    if sweep not in SWEEP_MODES:
+        raise StudyError(f"[study] sweep = {sweep!r}; allowed: {list(SWEEP_MODES)}")
+    dt = head.get("dt")
+    if dt is not None:
+        dt = check_positive("[study] dt", dt, "s")
+    output_hz = check_positive("[study] output_hz", head.get("output_hz", 1000.0), "Hz")
+    if abs(duration * output_hz - round(duration * output_hz)) > 1e-9 * duration * output_hz:
+        raise StudyError(f"[study] duration_s = {duration} s must be a whole number of samples "
+                         f"at output_hz = {output_hz} Hz (the last sample is the final state)")
+    initial = head.get("initial", "static")
+    if initial not in ("static", "paper"):
+        raise StudyError(f"[study] initial = {initial!r}; allowed: 'static', 'paper'")
+
+    exc = dict(data.get("excitation", {"kind": "none"}))
+    kind = exc.pop("kind", None)
+    if kind not in EXCITATION_KEYS:
+        raise StudyError(f"[excitation] kind = {kind!r}; allowed: {sorted(EXCITATION_KEYS)}")
+    fixed = dict(data.get("fixed", {}))
+    axes = dict(data.get("axes", {}))
+    for key, values in axes.items():
+        if not isinstance(values, list) or not values:
+            raise StudyError(f"[axes] {key} must be a non-empty list of values, got {values!r}")
+        if len(set(map(repr, values))) != len(values):
+            raise StudyError(f"[axes] {key} lists a value twice: {values}")
+    allowed_exc = set(EXCITATION_KEYS[kind])
+    for table, keys in (("excitation", exc), ("axes", axes), ("fixed", fixed)):
+        for key in keys:
+            if key in allowed_exc:
+                if table == "fixed":
+                    raise StudyError(f"[fixed] {key} is an excitation setting: put it in "
+                                     "[excitation] or [axes]")
+                continue
+            if key in ALL_EXCITATION_KEYS:
+                raise StudyError(f"[{table}] {key} does not apply to a {kind!r} excitation "
+                                 f"(its settings: {sorted(allowed_exc)})")
+            if table == "excitation":
+                raise StudyError(f"[excitation] unknown key {key!r}; a {kind!r} excitation "
+                                 f"takes {sorted(allowed_exc)}")
+            resolve_name(key)                      # raises, with a suggestion, if unknown
+    both = sorted(set(axes) & (set(fixed) | set(exc)))
+    if both:
+        raise StudyError(f"{both} given both as an axis and as a fixed value")
+    missing = sorted(k for k in allowed_exc - set(exc) - set(axes) - set(EXCITATION_DEFAULTS))
+    if missing:
+        raise StudyError(f"a {kind!r} excitation needs {missing} in [excitation] or [axes]")
+    if sweep != "independent" and (kind != "sine" or "freq_hz" not in axes):
+        raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a sine "
+                         "excitation with freq_hz in [axes]")
+
+    names = list(axes)
+    points = []
+    for combo in itertools.product(*(axes[n] for n in names)):
+        values = dict(zip(names, combo))
+        model_values = {**fixed, **{k: v for k, v in values.items() if k not in allowed_exc}}
+        params = Parameters.from_user(model_values)
+        settings = {"kind": kind}
+        for k in EXCITATION_KEYS[kind]:
+            settings[k] = values.get(k, exc.get(k, EXCITATION_DEFAULTS.get(k)))
+        pt = Point(values=values, params=params, excitation=settings)
+        pt.excitation_array()                      # validates the excitation values
+        points.append(pt)
+    if sweep != "independent":
+        points = _stepped(points, sweep)
+    else:
+        points = [Point(p.values, p.params, p.excitation, chain=i) for i, p in enumerate(points)]
+    series = tuple(dict(s) for s in head.get("save_series", []))
+    for sel in series:
+        bad = sorted(set(sel) - set(names) - set(allowed_exc))
+        if bad:
+            raise StudyError(f"[study] save_series selects by {bad}, which are not axes")
+    return Study(name=name, description=str(head.get("description", "")), duration_s=duration,
+                 window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
+                 excitation={"kind": kind, **exc}, fixed=fixed, axes=axes, save_series=series,
+                 source=source, points=tuple(points))
+
+
+def _stepped(points, sweep):
+    """Chains of equal non-frequency values, ordered by frequency (up, down or both)."""
+    chains: dict[tuple, list[Point]] = {}
+    for p in points:
+        key = tuple((k, repr(v)) for k, v in p.values.items() if k != "freq_hz")
+        chains.setdefault(key, []).append(p)
+    out = []
+    for c, members in enumerate(chains.values()):
+        up = sorted(members, key=lambda p: p.values["freq_hz"])
+        order = {"up": [(p, "up") for p in up],
+                 "down": [(p, "down") for p in reversed(up)],
+                 "up-down": [(p, "up") for p in up] + [(p, "down") for p in reversed(up[:-1])]}[sweep]
+        for step, (p, direction) in enumerate(order):
+            out.append(Point(p.values, p.params, p.excitation, chain=c, step=step,
+                             direction=direction))
+    return out

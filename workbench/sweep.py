@@ -1,0 +1,178 @@
+"""Run a study's grid in parallel, resumably (issue 4).
+
+    results/<study>/points/<key>.parquet   one row per finished point, written atomically
+    results/<study>/series/<key>.parquet   time series of the points the study names
+    results/<study>/points.parquet         all rows of the study's current grid
+
+``key`` hashes everything that determines a point: model parameters,
+excitation, duration, step, output rate, start, steady-state window, the
+key of the previous point of a stepped sweep, and the code version.  A
+rerun skips every point whose file exists; an interrupted sweep (even
+kill -9) loses at most the points in flight, because a file appears only
+by an atomic rename once its point is done.  A point that fails (the
+integration stops with a status, or Python raises) is recorded with its
+reason, and the sweep goes on; a stepped sweep then restarts the next
+frequency from the static equilibrium with the soft start.
+
+Parallelism is joblib's (``jobs`` processes), or a Dask cluster through
+joblib's dask backend (``scheduler="tcp://..."``).  Each chain of points
+(one point, or one stepped frequency sweep) is one task; results do not
+depend on the number of workers.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .core import layout as ly
+from .metrics import point_metrics
+from .provenance import code_version
+from .simulate import simulate
+from .study import Point, Study
+
+STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
+
+
+def point_key(study: Study, point: Point, previous_key: str = "") -> str:
+    """The hash (20 hex digits) naming a point's result file."""
+    record = {
+        "params": point.params.to_dict(), "excitation": point.excitation,
+        "first_in_chain": point.step == 0, "duration_s": study.duration_s,
+        "window_s": study.window_s, "dt": study.dt, "output_hz": study.output_hz,
+        "initial": study.initial, "previous": previous_key, "code": code_version(),
+    }
+    text = json.dumps(record, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def chain_keys(study: Study, chain: list[Point]) -> list[str]:
+    keys, prev = [], ""
+    for p in chain:
+        prev = point_key(study, p, prev if study.sweep != "independent" else "")
+        keys.append(prev)
+    return keys
+
+
+def _write_atomic(df: pd.DataFrame, path: Path) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    df.to_parquet(tmp)
+    os.replace(tmp, path)
+
+
+def _row(study, point, key, status, message, wall, metrics, run=None, continued=False):
+    row = {"key": key, **{f"axis_{k}": v for k, v in point.values.items()},
+           "chain": point.chain, "step": point.step, "direction": point.direction,
+           "continued": continued, "status": status, "message": message, "wall_s": wall}
+    row.update(metrics)
+    if run is not None:
+        row["simulated_s"] = run.simulated_s
+        row["n_events"] = int((run.events.kind != "start").sum())
+        row["max_penetration_cm"] = float(run.stats["max_penetration_cm"])
+        row["energy_balance_rel"] = run.energy_balance_rel()
+        final = run.signals.iloc[-1]
+        for i, c in enumerate(STATE_COLUMNS):
+            row[c] = float(final.iloc[i])
+    return row
+
+
+def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> dict:
+    """Simulate one point, write its row (and series), return the row."""
+    t0 = time.perf_counter()
+    continued = initial is not None
+    try:
+        run = simulate(point.params, point.excitation_array(first_in_chain=not continued),
+                       study.duration_s, dt=study.dt, output_hz=study.output_hz,
+                       initial=initial if continued else study.initial,
+                       free_decay_cm=point.free_decay_cm)
+        metrics = point_metrics(run, study.window_s, point.drive_hz) if run.ok else {}
+        row = _row(study, point, key, "ok" if run.ok else "failed", run.message,
+                   time.perf_counter() - t0, metrics, run, continued)
+        if study.saves_series(point):
+            _write_atomic(run.signals, out / "series" / f"{key}.parquet")
+            _write_atomic(run.events.astype({"kind": str}), out / "series" / f"{key}.events.parquet")
+    except Exception as exc:          # noqa: BLE001 - a failed point is data, the sweep goes on
+        msg = f"{type(exc).__name__}: {exc}"
+        row = _row(study, point, key, "error", msg, time.perf_counter() - t0, {},
+                   continued=continued)
+        row["traceback"] = traceback.format_exc(limit=5)
+    _write_atomic(pd.DataFrame([row]), out / "points" / f"{key}.parquet")
+    return row
+
+
+def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path) -> list[dict]:
+    """Run a chain's points in order, skipping finished ones (their state carries on)."""
+    rows = []
+    state = None
+    for point, key in zip(chain, keys):
+        path = out / "points" / f"{key}.parquet"
+        if path.exists():
+            row = pd.read_parquet(path).iloc[0].to_dict()
+        else:
+            row = run_point(study, point, key, out, initial=state)
+        rows.append(row)
+        state = None
+        if study.sweep != "independent" and row.get("status") == "ok":
+            state = np.array([row[c] for c in STATE_COLUMNS])
+    return rows
+
+
+def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
+              scheduler: str | None = None, fresh: bool = False, progress: bool = True) -> pd.DataFrame:
+    """Run every unfinished point of the study; return (and write) points.parquet."""
+    out = Path(results) / study.name
+    if fresh and (out / "points").exists():
+        for f in (out / "points").glob("*.parquet"):
+            f.unlink()
+    for sub in ("points", "series"):
+        (out / sub).mkdir(parents=True, exist_ok=True)
+        for tmp in (out / sub).glob(".*.tmp"):         # leftovers of a killed run
+            tmp.unlink(missing_ok=True)
+    chains = study.chains()
+    keys = [chain_keys(study, c) for c in chains]
+    todo = [(c, k) for c, k in zip(chains, keys)
+            if not all((out / "points" / f"{key}.parquet").exists() for key in k)]
+    n_points = sum(len(c) for c, _ in todo)
+    if todo:
+        _execute(study, todo, out, jobs, scheduler, progress, n_points)
+    rows = []
+    for k in keys:
+        for key in k:
+            path = out / "points" / f"{key}.parquet"
+            if path.exists():
+                rows.append(pd.read_parquet(path))
+    table = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
+    _write_atomic(table, out / "points.parquet")
+    return table
+
+
+def _execute(study, todo, out, jobs, scheduler, progress, n_points):
+    from joblib import Parallel, delayed, parallel_config
+
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=n_points, unit="point", desc=study.name)
+    tasks = (delayed(run_chain)(study, c, k, out) for c, k in todo)
+    if scheduler:
+        from dask.distributed import Client     # optional: pip install '.[cluster]'
+        client = Client(scheduler)
+        try:
+            with parallel_config(backend="dask"):
+                for rows in Parallel(return_as="generator_unordered")(tasks):
+                    if bar is not None:
+                        bar.update(len(rows))
+        finally:
+            client.close()
+    else:
+        for rows in Parallel(n_jobs=jobs, return_as="generator_unordered")(tasks):
+            if bar is not None:
+                bar.update(len(rows))
+    if bar is not None:
+        bar.close()
