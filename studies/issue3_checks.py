@@ -19,3 +19,17 @@ for tip in (True, False):
     print("paper 1 s tip", tip, "pen", s["max_penetration_cm"], "drift", s["max_drift_cm"], "dt", s["dt"])
 s = simulate(p.replace(gap_mm=1.016), sine(DEFAULT_FORCE_N, 20.0, ramp_s=1.0), 10.0).summary()
 print("10 s run", {k: s[k] for k in ("n_events", "n_impacts", "energy_balance_rel", "max_penetration_cm", "max_drift_cm", "wall_s")})
+
+# The kernel at the default step against the slow reference with events (tests/reference_hybrid.py)
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from reference_hybrid import HybridReference  # noqa: E402
+from workbench.core import layout as ly  # noqa: E402
+k = simulate(p, None, 0.036, initial="paper")
+log, yend = HybridReference(p).run(0.0, 0.036, np.zeros(ly.N_STATE))
+ev = k.events[k.events.kind != "start"]
+print("reference: events", len(ev), len(log), "max |dt|", max(abs(a - b["t"]) for a, b in zip(ev.t, log)))
+cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]
+e = np.abs(k.signals[cols].iloc[-1].to_numpy() - yend)
+print("reference: end state |dq|", e[:ly.N_DOF].max(), "|dq'|", e[ly.N_DOF:].max())
