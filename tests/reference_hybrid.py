@@ -108,6 +108,16 @@ class HybridReference:
         return np.array(A).reshape(-1, N), np.array(B).reshape(-1, N), np.array(conv), g, tau
 
     # ---- the equations of one regime -----------------------------------------------
+    def _kkt_solve(self, M, A, B, top, bottom):
+        """Solve [[M, -B^T], [A, 0]] (x, lambda) = (top, bottom) on the free coordinates."""
+        f = self.free
+        n, m = len(f), len(A)
+        K = np.zeros((n + m, n + m))
+        K[:n, :n] = M[np.ix_(f, f)]
+        K[:n, n:] = -B[:, f].T
+        K[n:, :n] = A[:, f]
+        return np.linalg.solve(K, np.concatenate([top, bottom]))
+
     def solve(self, t, y, reg):
         """(y', lambda_n (4,), lambda_t) of the regime at (t, y); cached for the events."""
         key = (t, y.tobytes(), reg)
@@ -117,14 +127,8 @@ class HybridReference:
         M, F = self.model.generalized(t, q, qd)
         f = self.free
         A, B, conv, _, _ = self.rows(q, qd, reg)
-        m = len(A)
         n = len(f)
-        K = np.zeros((n + m, n + m))
-        K[:n, :n] = M[np.ix_(f, f)]
-        K[:n, n:] = -B[:, f].T
-        K[n:, :n] = A[:, f]
-        rhs = np.concatenate([F[f], -conv])
-        x = np.linalg.solve(K, rhs)
+        x = self._kkt_solve(M, A, B, F[f], -conv)
         qdd = np.zeros(N)
         qdd[f] = x[:n]
         lam = x[n:]
@@ -185,12 +189,8 @@ class HybridReference:
                     continue
                 r = Regime(cand, stick, 0.0 if stick else float(np.sign(rate)))
                 A, B, _, _, _ = self.rows(q, qd, r)
-                n, m = len(f), len(A)
-                K = np.zeros((n + m, n + m))
-                K[:n, :n] = M[np.ix_(f, f)]
-                K[:n, n:] = -B[:, f].T
-                K[n:, :n] = A[:, f]
-                x = np.linalg.solve(K, np.concatenate([np.zeros(n), -A @ qd]))
+                n = len(f)
+                x = self._kkt_solve(M, A, B, np.zeros(n), -A @ qd)
                 qd_plus = qd.copy()
                 qd_plus[f] += x[:n]
                 P = x[n:]

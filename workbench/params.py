@@ -211,12 +211,7 @@ class Parameters:
     def from_toml(cls, path: str | Path) -> "Parameters":
         """Parameters from a TOML file: top-level keys or a ``[model]`` table."""
         path = Path(path)
-        try:
-            data = tomllib.loads(path.read_text())
-        except tomllib.TOMLDecodeError as exc:
-            raise ParameterError(f"{path}: not valid TOML: {exc}") from None
-        except OSError as exc:
-            raise ParameterError(f"{path}: cannot read: {exc.strerror}") from None
+        data = read_toml(path)
         if "model" in data:
             extra = sorted(set(data) - {"model"})
             if extra:
@@ -234,6 +229,17 @@ class Parameters:
 
 #: Metadata of every parameter, by name.
 FIELDS = {f.name: f for f in dataclasses.fields(Parameters)}
+
+
+def read_toml(path: Path, error=None) -> dict[str, Any]:
+    """The parsed TOML file; ``error`` (default ParameterError) names the file on failure."""
+    error = error or ParameterError
+    try:
+        return tomllib.loads(Path(path).read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path}: not valid TOML: {exc}") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot read: {exc.strerror}") from None
 
 
 def check_positive(name: str, value, unit: str, allow_zero: bool = False) -> float:

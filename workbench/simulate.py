@@ -23,6 +23,7 @@ from . import model as mdl
 from .core import layout as ly
 from .core.hybrid import run_hybrid
 from .excitation import none
+from .metrics import regime_time
 from .params import ParameterError, Parameters, check_positive
 from .statics import static_equilibrium, tip_load_for_deflection
 
@@ -113,13 +114,12 @@ class Run:
 
     def contact_time_share(self) -> dict[str, float]:
         """Fraction of the simulated time spent in each contact code (from the event log)."""
-        times = list(self.events.t) + [self.simulated_s]
-        regimes = list(self.events.to_regime)
         share: dict[str, float] = {}
         total = self.simulated_s - float(self.events.t.iloc[0])
-        for k, reg in enumerate(regimes):
-            code = str(contact_code(int(reg)))
-            share[code] = share.get(code, 0.0) + times[k + 1] - times[k]
+        for reg, dur in regime_time(self.events, float(self.events.t.iloc[0]),
+                                    self.simulated_s).items():
+            code = str(contact_code(reg))
+            share[code] = share.get(code, 0.0) + dur
         return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}
 
     def summary(self) -> dict:

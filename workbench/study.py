@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -43,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from . import excitation as X
-from .params import ParameterError, Parameters, check_positive, resolve_name
+from .params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 #: Excitation kinds and the keys each accepts (user units in the names).
 EXCITATION_KEYS = {
@@ -151,12 +150,7 @@ def _same(a, b):
 def load(path: str | Path) -> Study:
     """Read and validate a study file; raises StudyError naming what is wrong."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{path}: not valid TOML: {exc}") from None
-    except OSError as exc:
-        raise StudyError(f"{path}: cannot read: {exc.strerror}") from None
+    data = read_toml(path, StudyError)
     try:
         return from_dict(data, source=str(path))
     except ParameterError as exc:

@@ -66,7 +66,7 @@ def _write_atomic(df: pd.DataFrame, path: Path) -> None:
     os.replace(tmp, path)
 
 
-def _row(study, point, key, status, message, wall, metrics, run=None, continued=False):
+def _row(point, key, status, message, wall, metrics, run=None, continued=False):
     row = {"key": key, **{f"axis_{k}": v for k, v in point.values.items()},
            "chain": point.chain, "step": point.step, "direction": point.direction,
            "continued": continued, "status": status, "message": message, "wall_s": wall}
@@ -92,14 +92,14 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> 
                        initial=initial if continued else study.initial,
                        free_decay_cm=point.free_decay_cm)
         metrics = point_metrics(run, study.window_s, point.drive_hz) if run.ok else {}
-        row = _row(study, point, key, "ok" if run.ok else "failed", run.message,
+        row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)
         if study.saves_series(point):
             _write_atomic(run.signals, out / "series" / f"{key}.parquet")
             _write_atomic(run.events.astype({"kind": str}), out / "series" / f"{key}.events.parquet")
     except Exception as exc:          # noqa: BLE001 - a failed point is data, the sweep goes on
         msg = f"{type(exc).__name__}: {exc}"
-        row = _row(study, point, key, "error", msg, time.perf_counter() - t0, {},
+        row = _row(point, key, "error", msg, time.perf_counter() - t0, {},
                    continued=continued)
         row["traceback"] = traceback.format_exc(limit=5)
     _write_atomic(pd.DataFrame([row]), out / "points" / f"{key}.parquet")
