@@ -12,6 +12,7 @@ import pytest
 
 from workbench import study as S
 from workbench import sweep as W
+from workbench.report import make_report
 from workbench.params import ParameterError
 
 SMALL = """
@@ -124,6 +125,10 @@ def test_a_failing_point_is_recorded_and_the_sweep_goes_on(small_run, tmp_path, 
     assert len(bad) == 1 and len(table) == 4
     assert bad.status.iloc[0] == "error" and "injected failure" in bad.message.iloc[0]
     assert "RuntimeError" in bad.traceback.iloc[0]
+    report = make_report(study, tmp_path / "res").read_text()
+    assert "injected failure" in report           # listed with its reason
+    tables = tmp_path / "res" / "small" / "tables"
+    assert (tables / "response.md").read_text().count("failed") == 4 + 1   # 4 blocks + legend
 
 
 def test_an_unstable_point_is_recorded_as_failed(tmp_path):
@@ -184,3 +189,66 @@ def test_dask_cluster_gives_the_local_results(small_run, tmp_path):
         remote = W.run_study(study, tmp_path / "res", scheduler=cluster.scheduler_address,
                              progress=False)
     pd.testing.assert_frame_equal(comparable(remote), comparable(table), check_exact=True)
+
+
+def test_report_figures_and_tables_of_a_grid(small_run):
+    """Definition -> results -> figures -> tables: every artefact exists and says what the table says."""
+    import json
+    import re
+
+    study, root, table = small_run
+    out = root / "res1" / "small"
+    index = make_report(study, root / "res1")
+    tag = table[(table.axis_gap_mm == 1.016) & (table.axis_freq_hz == 20.0)].key.iloc[0][:8]
+    expected = ["frf_map_tip", "frf_map_strain1", "response_curves", "regime_shares",
+                "bifurcation", f"time_history_{tag}", f"strain_spectra_{tag}", f"switching_{tag}"]
+    for name in expected:
+        for ext in ("png", "pdf"):
+            assert (out / "figures" / f"{name}.{ext}").stat().st_size > 5000
+    links = re.findall(r"\]\(([^)]+)\)", index.read_text())
+    assert len(links) >= 2 * len(expected) + 6 + 2
+    assert all((out / link).exists() for link in links)
+    csv = pd.read_csv(out / "tables" / "response.csv")
+    merged = csv.merge(table, left_on=["gap_mm", "freq_hz"], right_on=["axis_gap_mm", "axis_freq_hz"])
+    assert len(merged) == 4 and np.allclose(merged.tip_rms_x, merged.tip_rms_y, rtol=1e-12)
+    md = (out / "tables" / "response.md").read_text()
+    block = md.split("## tip RMS (cm)")[1].split("##")[0]
+    assert block.count("*") == (~table.steady).sum()
+    for value in table.tip_rms:
+        assert f"{value:.3g}" in block
+    tex = (out / "tables" / "contact.tex").read_text()
+    assert tex.count(r"\begin{table}") == tex.count(r"\end{table}") == 5
+    prov = json.loads((out / "provenance.json").read_text())
+    assert prov["code_version"] and prov["packages"]["numba"]
+    assert prov["study"]["axes"]["gap_mm"] == [0.508, 1.016]
+    assert prov["runs"][0]["wall_s"] > 0 and prov["points"]["total"] == 4
+    # the bifurcation samples: one per forcing period of the window
+    assert all(len(s) == round(0.2 * f) + 1 for s, f in zip(table.tip_poincare, table.axis_freq_hz))
+
+
+def test_report_of_a_chirp_has_a_spectrogram(tmp_path):
+    text = """
+[study]
+name = "chirp"
+duration_s = 1.0
+window_s = 0.5
+save_series = [{gap_mm = 1.016}]
+
+[excitation]
+kind = "chirp"
+f0_hz = 5.0
+f1_hz = 65.0
+sweep_s = 1.0
+
+[axes]
+gap_mm = [1.016]
+"""
+    study = S.load(write(tmp_path, text))
+    table = W.run_study(study, tmp_path / "res", jobs=1, progress=False)
+    assert table.status.tolist() == ["ok"] and "tip_poincare" not in table
+    make_report(study, tmp_path / "res")
+    out = tmp_path / "res" / "chirp"
+    assert (out / "figures" / f"spectrogram_{table.key.iloc[0][:8]}.png").exists()
+    assert not (out / "figures" / "frf_map_tip.png").exists()     # no gap x frequency grid
+    long = pd.read_csv(out / "tables" / "response.csv")
+    assert long.tip_rms.iloc[0] == pytest.approx(table.tip_rms.iloc[0], rel=1e-12)

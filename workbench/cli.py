@@ -148,10 +148,22 @@ def _cmd_sweep(args) -> int:
     table = run_study(study, args.results, jobs=args.jobs, scheduler=args.scheduler,
                       fresh=args.fresh, progress=not args.quiet)
     counts = table.status.value_counts().to_dict() if len(table) else {}
-    print(json.dumps({"study": study.name, "points": study.n_points,
-                      "status": {str(k): int(v) for k, v in counts.items()},
-                      "results": str(Path(args.results) / study.name)}))
+    summary = {"study": study.name, "points": study.n_points,
+               "status": {str(k): int(v) for k, v in counts.items()},
+               "results": str(Path(args.results) / study.name)}
+    if not args.no_report:
+        from .report import make_report
+        summary["report"] = str(make_report(study, args.results))
+    print(json.dumps(summary))
     return 0 if counts.get("ok", 0) == study.n_points else 1
+
+
+def _cmd_report(args) -> int:
+    from .report import make_report
+    from .study import load
+
+    print(make_report(load(args.study), args.results))
+    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -200,7 +212,14 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--fresh", action="store_true", help="discard finished points first")
     sweep.add_argument("--results", default="results", help="results root (default results/)")
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.add_argument("--no-report", action="store_true",
+                       help="skip the figures, tables and report.md")
     sweep.set_defaults(func=_cmd_sweep)
+
+    report = sub.add_parser("report", help="figures, tables and report.md of a study already run")
+    report.add_argument("study", help="study definition (TOML)")
+    report.add_argument("--results", default="results", help="results root (default results/)")
+    report.set_defaults(func=_cmd_report)
 
     params = sub.add_parser("params", help="list every parameter with its unit, range and source")
     _add_model_options(params)

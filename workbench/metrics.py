@@ -19,6 +19,10 @@ Contact statistics from the event log (exact times, not samples):
 per forcing cycle (erg; per second without a drive frequency) by structural
 damping, cork damping, friction and impacts: ``diss_<mechanism>``.
 
+Bifurcation samples: ``tip_poincare`` lists the tip displacement (cm) once
+per forcing period, at t = k / f within the window (the drive's phase 0),
+interpolated by a cubic spline through the samples (sine runs only).
+
 Steady-state indicator (the first mode, ~2 Hz with zeta < 1 %, rings for
 tens of seconds): ``steady_change`` = |RMS_last - RMS_previous| / RMS_last
 of the tip displacement over the last two windows; ``steady`` is
@@ -27,6 +31,7 @@ of the tip displacement over the last two windows; ``steady`` is
 from __future__ import annotations
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from .core import layout as ly
 
@@ -35,6 +40,13 @@ HARMONICS = (0.5, 1.0, 2.0, 3.0)
 CONTACT_CODES = tuple(int(c) for c in ly.CONTACT_CODE)
 DISSIPATION = {"structural": "d_structural", "cork": "d_cork", "friction": "d_friction",
                "impact": "d_impact"}
+#: Printed names (with units) of the metrics shown in figures and tables.
+QUANTITIES = {
+    "tip_rms": "tip RMS (cm)", "tip_h1": "tip at f (cm)", "strain1_rms": "strain1 RMS (-)",
+    "accel3_rms": "accel3 RMS (cm/s²)", "impacts_per_s": "impacts per s",
+    "switches_per_s": "switches per s", "stick_share": "stick share",
+    "share_0": "free-flight share",
+}
 #: Default bound on the relative RMS change between the last two windows.
 STEADY_TOL = 0.05
 
@@ -47,6 +59,12 @@ def harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> dict[float
         cols += [np.cos(w * t), np.sin(w * t)]
     coef, *_ = np.linalg.lstsq(np.column_stack(cols), x, rcond=None)
     return {k: float(np.hypot(coef[1 + 2 * i], coef[2 + 2 * i])) for i, k in enumerate(HARMONICS)}
+
+
+def once_per_period(t: np.ndarray, x: np.ndarray, f_hz: float) -> np.ndarray:
+    """x at the times k / f_hz (k integer) inside [t[0], t[-1]], by a cubic spline."""
+    k = np.arange(np.ceil(t[0] * f_hz - 1e-9), np.floor(t[-1] * f_hz + 1e-9) + 1)
+    return CubicSpline(t, x)(k / f_hz)
 
 
 def regime_time(events, t0: float, t1: float) -> dict[int, float]:
@@ -82,6 +100,8 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
         if drive_hz:
             for k, a in harmonic_amplitudes(t[win], xw, drive_hz).items():
                 out[f"{ch}_h{k:g}"] = a
+    if drive_hz:
+        out["tip_poincare"] = once_per_period(t[win], tip[win], drive_hz).tolist()
     rms_prev = float(np.std(tip[prev])) if prev.sum() > 1 else float("nan")
     rms_last = out["tip_rms"]
     change = abs(rms_last - rms_prev) / rms_last if rms_last > 0 else 0.0

@@ -76,6 +76,7 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
         row["n_events"] = int((run.events.kind != "start").sum())
         row["max_penetration_cm"] = float(run.stats["max_penetration_cm"])
         row["energy_balance_rel"] = run.energy_balance_rel()
+        row["static_tip_y"] = run.static_tip_y
         final = run.signals.iloc[-1]
         for i, c in enumerate(STATE_COLUMNS):
             row[c] = float(final.iloc[i])
@@ -140,7 +141,11 @@ def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
             if not all((out / "points" / f"{key}.parquet").exists() for key in k)]
     n_points = sum(len(c) for c, _ in todo)
     if todo:
+        t0 = time.perf_counter()
         _execute(study, todo, out, jobs, scheduler, progress, n_points)
+        _log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "points_run": n_points,
+                       "jobs": jobs, "scheduler": scheduler,
+                       "wall_s": time.perf_counter() - t0})
     rows = []
     for k in keys:
         for key in k:
@@ -150,6 +155,13 @@ def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
     table = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
     _write_atomic(table, out / "points.parquet")
     return table
+
+
+def _log_run(out: Path, entry: dict) -> None:
+    """Append an invocation's wall time to runs.json (read by the report's provenance)."""
+    path = out / "runs.json"
+    runs = json.loads(path.read_text()) if path.exists() else []
+    path.write_text(json.dumps(runs + [entry], indent=1) + "\n")
 
 
 def _execute(study, todo, out, jobs, scheduler, progress, n_points):

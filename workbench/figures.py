@@ -1,0 +1,277 @@
+"""Figures of a study (issue 4), in the style of the paper's §6, as PNG and PDF.
+
+From the points table (one row per grid point, :mod:`workbench.sweep`):
+
+- :func:`frf_maps`            tip RMS over gap x frequency, a panel per other axis value
+- :func:`response_curves`     tip RMS against frequency, a line per gap
+- :func:`regime_shares`       contact-code time shares by frequency (stacked bars)
+- :func:`bifurcation`         tip once per forcing period against frequency,
+                              up and down sweeps overlaid
+
+From the saved time series of single points:
+
+- :func:`time_history`        force, strains, accelerations, tip (Fig. 6)
+- :func:`strain_spectra`      power spectra of both strains (Fig. 7-8)
+- :func:`switching_diagram`   the contact code against time (Fig. 9)
+- :func:`spectrogram`         short-time spectrum of a strain (Fig. 11-12)
+
+Points that are not steady (``steady`` False) are marked, failed points are
+shown as gaps: nothing is silently mixed in.  Every function returns the
+figure; :func:`save` writes it.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+from scipy import signal as sps  # noqa: E402
+
+from .metrics import CONTACT_CODES, QUANTITIES  # noqa: E402
+
+AXIS_LABELS = {"gap_mm": "gap (mm)", "freq_hz": "drive frequency (Hz)", "tip_mass": "tip mass",
+               "cork": "cork", "force_n": "force (N)", "mu": "friction coefficient"}
+CODE_COLORS = dict(zip(CONTACT_CODES, plt.get_cmap("tab10").colors))
+SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
+                   ("strain2", "strain2 (-)"), ("accel1", "accel1 (cm/s²)"),
+                   ("accel3", "accel3 (cm/s²)"), ("tip", "tip displacement (cm)"))
+
+
+def save(fig, path: Path) -> list[Path]:
+    """Write ``fig`` as ``path``.png and ``path``.pdf; return both paths."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    out = [path.with_suffix(".png"), path.with_suffix(".pdf")]
+    for p in out:
+        fig.savefig(p, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return out
+
+
+def label(axis: str) -> str:
+    return AXIS_LABELS.get(axis, axis)
+
+
+def axis_text(axis: str, value) -> str:
+    """'gap 1.016 mm', 'tip mass on', 'cork cubic' for a panel title."""
+    if isinstance(value, (bool, np.bool_)):
+        return f"{label(axis)} {'on' if value else 'off'}"
+    name = label(axis)
+    if name.endswith(")"):                      # 'gap (mm)' -> 'gap 1.016 mm'
+        base, unit = name[:-1].split(" (")
+        return f"{base} {value:g} {unit}"
+    return f"{name} {value}"
+
+
+def panels(table: pd.DataFrame, exclude: tuple[str, ...]) -> list[tuple[str, pd.DataFrame]]:
+    """Split the table by every axis not in ``exclude`` that takes several values."""
+    by = [c for c in table.columns if c.startswith("axis_") and c[5:] not in exclude
+          and table[c].nunique() > 1]
+    if not by:
+        return [("", table)]
+    out = []
+    for values, group in table.groupby(by, sort=True):
+        values = values if isinstance(values, tuple) else (values,)
+        out.append((", ".join(axis_text(c[5:], v) for c, v in zip(by, values)), group))
+    return out
+
+
+def _grid(n: int, width=4.2, height=3.2, **kw):
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False,
+                             layout="constrained", **kw)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    return fig, list(axes.flat[:n])
+
+
+def _ok(table):
+    return table[table.status == "ok"]
+
+
+def frf_maps(table: pd.DataFrame, quantity: str = "tip_rms"):
+    """Colour map of ``quantity`` over gap x drive frequency; 'x' marks points not steady."""
+    parts = panels(table, ("gap_mm", "freq_hz"))
+    fig, axes = _grid(len(parts), sharex=True, sharey=True)
+    values = _ok(table)[quantity].to_numpy()
+    values = values[values > 0]
+    vmax = values.max() if len(values) else 1.0
+    norm = matplotlib.colors.LogNorm(vmin=max(values.min(), vmax * 1e-3) if len(values) else 1e-3,
+                                     vmax=vmax)
+    gaps = np.sort(table.axis_gap_mm.unique())
+    freqs = np.sort(table.axis_freq_hz.unique())
+    for ax, (title, part) in zip(axes, parts):
+        grid = np.full((len(gaps), len(freqs)), np.nan)
+        for _, r in _ok(part).iterrows():
+            grid[np.searchsorted(gaps, r.axis_gap_mm), np.searchsorted(freqs, r.axis_freq_hz)] = \
+                r[quantity]
+        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis", norm=norm,
+                       extent=(-0.5, len(freqs) - 0.5, -0.5, len(gaps) - 0.5))
+        for _, r in _ok(part).iterrows():
+            ax.text(np.searchsorted(freqs, r.axis_freq_hz), np.searchsorted(gaps, r.axis_gap_mm),
+                    f"{r[quantity]:.2g}" + ("" if r.steady else "*"), ha="center", va="center",
+                    fontsize=6, color="w")
+        ax.set_xticks(range(len(freqs)), [f"{f:g}" for f in freqs], fontsize=7)
+        ax.set_yticks(range(len(gaps)), [f"{g:g}" for g in gaps])
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel(label("freq_hz"))
+        ax.set_ylabel(label("gap_mm"))
+    fig.colorbar(im, ax=axes, label=f"{QUANTITIES[quantity]}; *: not steady, blank: failed")
+    return fig
+
+
+def response_curves(table: pd.DataFrame, quantity: str = "tip_rms"):
+    """``quantity`` against drive frequency, a line per gap; hollow markers: not steady."""
+    parts = panels(table, ("gap_mm", "freq_hz"))
+    fig, axes = _grid(len(parts), sharey=True)
+    for ax, (title, part) in zip(axes, parts):
+        ax.set_yscale("log")
+        for i, (gap, g) in enumerate(_ok(part).groupby("axis_gap_mm")):
+            g = g.sort_values("axis_freq_hz")
+            color = f"C{i}"
+            ax.plot(g.axis_freq_hz, g[quantity], "-", color=color, label=f"{gap:g} mm")
+            steady = g.steady.astype(bool)
+            ax.plot(g.axis_freq_hz[steady], g[quantity][steady], "o", color=color, ms=4)
+            ax.plot(g.axis_freq_hz[~steady], g[quantity][~steady], "o", mfc="none",
+                    color=color, ms=6)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel(label("freq_hz"))
+        ax.set_ylabel(QUANTITIES[quantity])
+        ax.grid(alpha=0.3)
+    axes[0].legend(title="gap (hollow: not steady)", fontsize=7, title_fontsize=7)
+    return fig
+
+
+def regime_shares(table: pd.DataFrame):
+    """Stacked bars of the contact-code time shares per drive frequency, a panel per rest."""
+    parts = panels(table, ("freq_hz",))
+    fig, axes = _grid(len(parts), sharey=True)
+    for ax, (title, part) in zip(axes, parts):
+        part = _ok(part).sort_values("axis_freq_hz")
+        x = np.arange(len(part))
+        bottom = np.zeros(len(part))
+        for code in CONTACT_CODES:
+            share = part[f"share_{code}"].to_numpy()
+            ax.bar(x, share, bottom=bottom, color=CODE_COLORS[code], width=0.8, label=str(code))
+            bottom += share
+        ax.set_xticks(x, [f"{f:g}{'' if s else '*'}" for f, s in
+                          zip(part.axis_freq_hz, part.steady.astype(bool))], fontsize=7)
+        ax.set_ylim(0, 1)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel(label("freq_hz") + " (*: not steady)")
+        ax.set_ylabel("time share")
+    axes[-1].legend(title="contact", fontsize=7, title_fontsize=7, bbox_to_anchor=(1.02, 1),
+                    loc="upper left")
+    return fig
+
+
+def bifurcation(table: pd.DataFrame):
+    """Tip displacement once per forcing period against frequency (up and down overlaid)."""
+    parts = panels(table, ("freq_hz",))
+    fig, axes = _grid(len(parts))
+    styles = {"up": ("C0", "^", "up"), "down": ("C3", "v", "down"), "": ("k", ".", "")}
+    for ax, (title, part) in zip(axes, parts):
+        for direction, g in _ok(part).groupby("direction"):
+            color, marker, name = styles.get(direction, styles[""])
+            f = np.concatenate([np.full(len(s), fr) for fr, s in zip(g.axis_freq_hz,
+                                                                      g.tip_poincare)])
+            y = np.concatenate([np.asarray(s, float) for s in g.tip_poincare])
+            ax.plot(f, y, marker, color=color, ms=3, alpha=0.6, ls="none",
+                    label=f"{name} sweep" if name else None)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel(label("freq_hz"))
+        ax.set_ylabel("tip at phase 0 (cm)")
+        ax.grid(alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+    return fig
+
+
+def _window(signals: pd.DataFrame, seconds: float | None):
+    if seconds is None:
+        return signals
+    t = signals.index.to_numpy()
+    return signals[t >= t[-1] - seconds]
+
+
+def time_history(signals: pd.DataFrame, static_tip_y: float, title: str, seconds: float = 0.5):
+    """The last ``seconds`` of the sensor channels and the tip (paper Fig. 6)."""
+    s = _window(signals, seconds)
+    fig, axes = plt.subplots(len(SERIES_CHANNELS), 1, figsize=(8, 1.6 * len(SERIES_CHANNELS)),
+                             sharex=True)
+    t = s.index.to_numpy()
+    for ax, (ch, name) in zip(axes, SERIES_CHANNELS):
+        y = s.tip_y - static_tip_y if ch == "tip" else s[ch]
+        ax.plot(t, y, lw=0.8)
+        ax.set_ylabel(name, fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[0].set_title(title, fontsize=9)
+    axes[-1].set_xlabel("time (s)")
+    return fig
+
+
+def strain_spectra(signals: pd.DataFrame, title: str, seconds: float | None = None,
+                   fmax: float = 250.0):
+    """Power spectral density of strain1 and strain2 (Welch, 1 s segments; Fig. 7-8)."""
+    s = _window(signals, seconds)
+    t = s.index.to_numpy()
+    fs = 1.0 / np.median(np.diff(t))
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    for ch in ("strain1", "strain2"):
+        f, p = sps.welch(s[ch].to_numpy(), fs=fs, nperseg=min(len(t), int(round(fs))),
+                         detrend="constant")
+        keep = f <= fmax
+        ax.semilogy(f[keep], p[keep], lw=0.9, label=ch)
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("strain PSD (1/Hz)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def switching_diagram(events: pd.DataFrame, t_end: float, title: str, seconds: float = 0.5):
+    """The contact code against time over the last ``seconds`` (paper Fig. 9)."""
+    from .simulate import contact_code
+
+    t0 = t_end - seconds
+    t = events.t.to_numpy()
+    codes = np.array([contact_code(int(r)) for r in events.to_regime])
+    keep = t >= t0
+    first = codes[keep.argmax() - 1] if keep.any() and keep.argmax() > 0 else \
+        (codes[-1] if len(codes) else 0)
+    tt = np.concatenate([[t0], t[keep], [t_end]])
+    cc = np.concatenate([[first], codes[keep], [codes[keep][-1] if keep.any() else first]])
+    level = {c: i for i, c in enumerate(CONTACT_CODES)}
+    fig, ax = plt.subplots(figsize=(8, 3))
+    ax.step(tt, [level[int(c)] for c in cc], where="post", lw=0.9)
+    ax.set_yticks(range(len(CONTACT_CODES)), [str(c) for c in CONTACT_CODES])
+    ax.set_ylabel("points in contact")
+    ax.set_xlabel("time (s)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def spectrogram(signals: pd.DataFrame, title: str, channel: str = "strain1",
+                fmax: float = 200.0, segment_s: float = 2.0):
+    """Short-time power spectrum of ``channel`` against time in minutes (Fig. 11-12)."""
+    t = signals.index.to_numpy()
+    fs = 1.0 / np.median(np.diff(t))
+    n = min(int(round(segment_s * fs)), len(t) // 4)
+    f, tt, sxx = sps.spectrogram(signals[channel].to_numpy(), fs=fs, nperseg=n,
+                                 noverlap=n // 2, detrend="constant")
+    keep = f <= fmax
+    fig, ax = plt.subplots(figsize=(8, 4))
+    db = 10 * np.log10(sxx[keep] + 1e-300)
+    im = ax.pcolormesh((t[0] + tt) / 60.0, f[keep], db, shading="auto", cmap="jet",
+                       vmin=db.max() - 80, vmax=db.max())
+    fig.colorbar(im, ax=ax, label=f"{channel} PSD (dB re 1/Hz)")
+    ax.set_xlabel("time (min)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title(title, fontsize=9)
+    return fig

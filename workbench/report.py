@@ -1,0 +1,134 @@
+"""A study's report (issue 4): figures, tables, an index and the provenance.
+
+    results/<study>/figures/*.png, *.pdf
+    results/<study>/tables/{response,contact}.{csv,md,tex}
+    results/<study>/report.md          links every figure and table
+    results/<study>/provenance.json    code version, packages, machine,
+                                       study definition, wall times
+
+Which figures a study gets depends on its axes: the maps and curves need
+gap_mm and freq_hz axes, the shares and the bifurcation diagram need a
+sine drive over several frequencies; every point with a saved time series
+gets a time history, strain spectra and a switching diagram, and a chirp a
+spectrogram as well.
+"""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from . import figures as F
+from .provenance import environment
+from .study import Study
+from .tables import write_tables
+
+
+def point_title(row) -> str:
+    """'gap 1.016 mm, 20 Hz, ...' from a points-table row's axis values."""
+    return ", ".join(F.axis_text(k[5:], v) for k, v in row.items() if k.startswith("axis_"))
+
+
+def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
+    has = {a for a in ("gap_mm", "freq_hz") if f"axis_{a}" in table and table[f"axis_{a}"].nunique() > 1}
+    sine = study.excitation["kind"] == "sine" and "freq_hz" in has
+    figs = {}
+    if not (table.status == "ok").any():
+        return figs
+    if has == {"gap_mm", "freq_hz"}:
+        figs["frf_map_tip"] = lambda: F.frf_maps(table)
+        figs["frf_map_strain1"] = lambda: F.frf_maps(table, "strain1_rms")
+        figs["response_curves"] = lambda: F.response_curves(table)
+    if sine:
+        figs["regime_shares"] = lambda: F.regime_shares(table)
+        figs["bifurcation"] = lambda: F.bifurcation(table)
+    return figs
+
+
+def _series_figures(study: Study, table: pd.DataFrame, out: Path) -> dict[str, object]:
+    figs = {}
+    for _, row in table.iterrows():
+        path = out / "series" / f"{row.key}.parquet"
+        if row.status != "ok" or not path.exists():
+            continue
+        sig = pd.read_parquet(path)
+        ev = pd.read_parquet(path.with_suffix(".events.parquet"))
+        title = point_title(row)
+        t_end = float(sig.index[-1])
+        tag = row.key[:8]
+        figs[f"time_history_{tag}"] = lambda s=sig, r=row, ti=title: F.time_history(
+            s, r.static_tip_y, ti, seconds=min(0.5, study.window_s))
+        figs[f"strain_spectra_{tag}"] = lambda s=sig, ti=title: F.strain_spectra(
+            s, ti, seconds=study.window_s)
+        figs[f"switching_{tag}"] = lambda e=ev, te=t_end, ti=title: F.switching_diagram(
+            e, te, ti, seconds=min(0.5, study.window_s))
+        if study.excitation["kind"] == "chirp":
+            figs[f"spectrogram_{tag}"] = lambda s=sig, ti=title: F.spectrogram(s, ti)
+    return figs
+
+
+def make_report(study: Study, results: str | Path = "results") -> Path:
+    """Write figures, tables, report.md and provenance.json for a study already run."""
+    out = Path(results) / study.name
+    table = pd.read_parquet(out / "points.parquet")
+    t0 = time.perf_counter()
+    made = {}
+    for name, build in {**_grid_figures(study, table), **_series_figures(study, table, out)}.items():
+        made[name] = F.save(build(), out / "figures" / name)
+    tables = write_tables(table, out / "tables")
+    report_wall = time.perf_counter() - t0
+    provenance = {**environment(), "study": study_definition(study),
+                  "points": summary(table), "report_wall_s": report_wall,
+                  "runs": read_runs(out)}
+    (out / "provenance.json").write_text(json.dumps(provenance, indent=2, default=str) + "\n")
+    index = out / "report.md"
+    index.write_text(render_index(study, table, made, tables, out))
+    return index
+
+
+def study_definition(study: Study) -> dict:
+    return {"name": study.name, "description": study.description, "source": study.source,
+            "duration_s": study.duration_s, "window_s": study.window_s, "sweep": study.sweep,
+            "dt": study.dt, "output_hz": study.output_hz, "initial": study.initial,
+            "excitation": study.excitation, "fixed": study.fixed, "axes": study.axes,
+            "parameters_of_first_point": study.points[0].params.to_dict() if study.points else {}}
+
+
+def summary(table: pd.DataFrame) -> dict:
+    ok = table[table.status == "ok"] if len(table) else table
+    return {"total": len(table),
+            "status": {str(k): int(v) for k, v in table.status.value_counts().items()},
+            "not_steady": int((~ok.steady.astype(bool)).sum()) if len(ok) else 0,
+            "cpu_s": float(table.wall_s.sum()) if len(table) else 0.0,
+            "simulated_s": float(ok.simulated_s.sum()) if len(ok) else 0.0}
+
+
+def read_runs(out: Path) -> list:
+    path = out / "runs.json"
+    return json.loads(path.read_text()) if path.exists() else []
+
+
+def render_index(study, table, figures, tables, out) -> str:
+    s = summary(table)
+    lines = [f"# Study `{study.name}`", "", study.description, "",
+             f"Definition: `{study.source}`; {study.n_points} points, {study.duration_s:g} s each, "
+             f"steady-state window {study.window_s:g} s, sweep {study.sweep}.", "",
+             f"Points: {s['status']}; not steady: {s['not_steady']}; "
+             f"{s['simulated_s']:.0f} simulated s in {s['cpu_s']:.0f} CPU s.", "",
+             "Data: [points.parquet](points.parquet) (one row per point), "
+             "[provenance.json](provenance.json).", ""]
+    failed = table[table.status != "ok"] if len(table) else table
+    if len(failed):
+        lines += ["## Points that did not finish", "", "| point | status | reason |", "|---|---|---|"]
+        lines += [f"| {point_title(r)} | {r.status} | {r.message} |" for _, r in failed.iterrows()]
+        lines.append("")
+    lines += ["## Tables", ""]
+    for p in tables:
+        lines.append(f"- [{p.name}]({p.relative_to(out)})")
+    lines += ["", "## Figures", ""]
+    for name, paths in figures.items():
+        png, pdf = (p.relative_to(out) for p in paths)
+        lines += [f"### {name}", "", f"![{name}]({png}) ([PDF]({pdf}))", ""]
+    return "\n".join(lines) + "\n"

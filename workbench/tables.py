@@ -1,0 +1,112 @@
+"""Paper-style tables of a study (issue 4): CSV, Markdown and LaTeX.
+
+Two tables, each per gap x drive frequency with a block per value of the
+other axes (tip mass, cork, ...):
+
+- ``response``: RMS of the tip displacement (cm), of strain1 and accel3,
+  and the amplitude at the drive frequency;
+- ``contact``: impacts and regime switches per second, stick share, the
+  share of free flight and the dominant contact code.
+
+The CSV is long (one row per point, every column, ``steady`` and
+``status`` included).  The Markdown and LaTeX tables pivot one quantity per
+block: gap rows, frequency columns; ``*`` marks a point that is not steady
+and ``failed`` one that did not finish.  A study without both axes gets
+the long table in every format.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from .metrics import CONTACT_CODES, QUANTITIES
+
+TABLES = {
+    "response": {k: QUANTITIES[k] for k in ("tip_rms", "tip_h1", "strain1_rms", "accel3_rms")},
+    "contact": {**{k: QUANTITIES[k] for k in ("impacts_per_s", "switches_per_s", "stick_share",
+                                              "share_0")},
+                "dominant_code": "dominant contact code"},
+}
+PIVOT = ("gap_mm", "freq_hz")
+
+
+def with_dominant_code(table: pd.DataFrame) -> pd.DataFrame:
+    """Add ``dominant_code``: the contact code with the largest time share."""
+    shares = table[[f"share_{c}" for c in CONTACT_CODES]]
+    out = table.copy()
+    out["dominant_code"] = [int(c.split("_")[1]) if pd.notna(v) else pd.NA
+                            for c, v in zip(shares.fillna(-1).idxmax(axis=1), shares.max(axis=1))]
+    return out
+
+
+def cell(row, quantity: str) -> str:
+    """A point's value as printed: 3 significant digits, '*' if not steady."""
+    if row.status != "ok":
+        return "failed"
+    v = row[quantity]
+    text = f"{v:.3g}" if isinstance(v, float) else str(v)
+    return text if bool(row.steady) else text + "*"
+
+
+def pivots(table: pd.DataFrame, quantity: str) -> list[tuple[str, pd.DataFrame]]:
+    """(block title, gap x frequency frame of printed cells) per value of the other axes."""
+    from .figures import label, panels
+
+    out = []
+    for title, part in panels(table, PIVOT):
+        grid = pd.DataFrame({
+            f"{f:g} Hz": {f"{r.axis_gap_mm:g}": cell(r, quantity)
+                          for _, r in part.iterrows() if r.axis_freq_hz == f}
+            for f in sorted(part.axis_freq_hz.unique())})
+        grid.index.name = label("gap_mm")
+        out.append((title, grid.sort_index()))
+    return out
+
+
+def latex_text(text: str) -> str:
+    """Escape the characters LaTeX treats specially in running text."""
+    for a, b in (("\\", r"\textbackslash{}"), ("_", r"\_"), ("%", r"\%"), ("&", r"\&"),
+                 ("#", r"\#")):
+        text = text.replace(a, b)
+    return text
+
+
+def _long(table: pd.DataFrame, columns: dict) -> pd.DataFrame:
+    axes = [c for c in table.columns if c.startswith("axis_")]
+    keep = axes + ["status", "steady", "steady_change"] + [c for c in columns if c in table]
+    return table[keep].rename(columns={c: c[5:] for c in axes})
+
+
+def write_tables(table: pd.DataFrame, out: Path) -> list[Path]:
+    """Write every table of the module docstring under ``out``; return the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    ok = table.status == "ok"
+    if ok.any():
+        table = with_dominant_code(table)
+    else:
+        table = table.assign(dominant_code=pd.NA)
+    pivotable = all(f"axis_{a}" in table for a in PIVOT)
+    written = []
+    for name, columns in TABLES.items():
+        present = {c: t for c, t in columns.items() if c in table}
+        long = _long(table, present)
+        csv = out / f"{name}.csv"
+        long.to_csv(csv, index=False)
+        md, tex = [f"# {name.capitalize()} per point\n"], []
+        if pivotable:
+            md.append("`*`: not steady (RMS changed by more than the tolerance between the "
+                      "last two windows); `failed`: see points.parquet.\n")
+            for quantity, title in present.items():
+                for block, grid in pivots(table, quantity):
+                    caption = f"{title}{', ' + block if block else ''}"
+                    md += [f"\n## {caption}\n", grid.to_markdown(stralign="right"), ""]
+                    tex.append(grid.to_latex(caption=latex_text(caption), escape=True,
+                                             position="htbp").replace("*", r"$^*$"))
+        else:
+            md.append(long.to_markdown(index=False, floatfmt=".4g"))
+            tex.append(long.to_latex(index=False, float_format="%.4g", escape=True))
+        (out / f"{name}.md").write_text("\n".join(md) + "\n")
+        (out / f"{name}.tex").write_text("\n".join(tex).replace("²", "$^2$"))
+        written += [csv, out / f"{name}.md", out / f"{name}.tex"]
+    return written
