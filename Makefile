@@ -8,7 +8,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 RESULTS := results
 
-.PHONY: help setup test bench study clean modes
+.PHONY: help setup test bench study clean
 
 help:  ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-8s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -29,9 +29,20 @@ bench: $(STAMP)  ## run the benchmarks (pytest-benchmark), save JSON under .benc
 	$(PY) -m pytest -q benchmarks --benchmark-only --benchmark-enable --benchmark-autosave \
 		--benchmark-columns=min,median,max,rounds -p no:randomly
 
-study: $(RESULTS)/modes/modes.md  ## run the main study (today: the modal table of the model)
+# The studies of `make study` (studies/<name>.toml -> results/<name>/report.md).
+STUDIES := free_decay stepped chirp shaker
+SOURCES := $(wildcard workbench/*.py workbench/core/*.py)
 
-$(RESULTS)/modes/modes.md: $(STAMP) studies/modes.py $(wildcard workbench/*.py workbench/core/*.py)
+study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, modes)
+
+$(RESULTS)/index.md: $(foreach s,$(STUDIES),$(RESULTS)/$(s)/report.md) $(RESULTS)/modes/modes.md studies/index.py
+	$(PY) studies/index.py $(RESULTS) $(STUDIES) modes
+
+# Exit status 3: the sweep finished but some points failed; they are listed in the report.
+$(RESULTS)/%/report.md: studies/%.toml $(SOURCES) $(STAMP)
+	$(PY) -m workbench sweep $< --results $(RESULTS) || [ $$? -eq 3 ]
+
+$(RESULTS)/modes/modes.md: $(STAMP) studies/modes.py $(SOURCES)
 	$(PY) studies/modes.py --out $(RESULTS)/modes
 
 clean:  ## remove generated results (keeps results/README.md) and caches

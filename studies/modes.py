@@ -1,23 +1,21 @@
 """Modal table of the model: natural frequencies for tip mass on/off, joint
 locked/free and every cork model, linearised about the undeformed state.
 
-Writes ``modes.csv``, ``modes.md`` and ``provenance.json`` into ``--out``.
-Run by ``make study`` until the sweep studies arrive (issue 4).
+Writes ``modes.csv``, ``modes.md`` and ``provenance.json`` into ``--out``;
+part of ``make study``.
 """
 from __future__ import annotations
 
 import argparse
 import json
-import platform
 import time
-from importlib import metadata
 from pathlib import Path
 
 import pandas as pd
 
-from workbench import __version__
 from workbench.modes import natural_frequencies
 from workbench.params import CORK_MODELS, Parameters
+from workbench.provenance import environment
 
 N_MODES = 6
 
@@ -53,12 +51,8 @@ def main() -> None:
             "rigid_modes, 0 Hz) and the elastic frequencies follow.\n\n")
     (args.out / "modes.md").write_text("# Modal table\n\n" + note
                                        + df.to_markdown(index=False, floatfmt=".3f") + "\n")
-    provenance = {
-        "study": "modes", "workbench": __version__, "python": platform.python_version(),
-        "machine": platform.platform(), "wall_s": time.perf_counter() - start,
-        "packages": {k: metadata.version(k) for k in ("numba", "numpy", "scipy", "pandas")},
-        "parameters": Parameters().to_dict(),
-    }
+    provenance = {**environment(), "study": "modes", "wall_s": time.perf_counter() - start,
+                  "parameters": Parameters().to_dict()}
     (args.out / "provenance.json").write_text(json.dumps(provenance, indent=1, default=str))
     print(f"wrote {args.out}/modes.csv, modes.md, provenance.json")
 

@@ -155,7 +155,11 @@ def _cmd_sweep(args) -> int:
         from .report import make_report
         summary["report"] = str(make_report(study, args.results))
     print(json.dumps(summary))
-    return 0 if counts.get("ok", 0) == study.n_points else 1
+    return 0 if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
+
+
+#: Exit status of ``workbench sweep`` when the sweep ran but some points failed.
+EXIT_POINTS_FAILED = 3
 
 
 def _cmd_report(args) -> int:

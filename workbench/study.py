@@ -8,6 +8,7 @@
     dt = 5e-5                        # optional RK4 step (s); default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
+                                     # (each selector names axis values; {} selects every point)
 
     [excitation]
     kind = "sine"                    # sine | chirp | free_decay | hammer_joint | hammer_tip | none
