@@ -34,7 +34,7 @@ import pandas as pd
 from .core import layout as ly
 from .metrics import point_metrics
 from .provenance import code_version
-from .simulate import simulate
+from .simulate import default_dt, simulate
 from .study import Point, Study
 
 STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
@@ -124,6 +124,11 @@ def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path) -> l
     return rows
 
 
+def estimated_cost(study: Study, chain: list[Point]) -> float:
+    """RK4 steps of a chain: the longest chains start first, so that workers finish together."""
+    return sum(study.duration_s / (study.dt or default_dt(p.params)) for p in chain)
+
+
 def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
               scheduler: str | None = None, fresh: bool = False, progress: bool = True) -> pd.DataFrame:
     """Run every unfinished point of the study; return (and write) points.parquet."""
@@ -139,6 +144,7 @@ def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
     keys = [chain_keys(study, c) for c in chains]
     todo = [(c, k) for c, k in zip(chains, keys)
             if not all((out / "points" / f"{key}.parquet").exists() for key in k)]
+    todo.sort(key=lambda item: -estimated_cost(study, item[0]))
     n_points = sum(len(c) for c, _ in todo)
     if todo:
         t0 = time.perf_counter()

@@ -19,7 +19,8 @@ import numba as nb
 from ..config import CHOLESKY_REL_PIVOT, JIT, JIT_INLINE
 from . import layout as ly
 from .excitation import hammer_force, shaker_force
-from .kinematics import beam_b_point, compute_frames, element, n_elements, rigid_point, tip_row
+from .inertia import frame_sums
+from .kinematics import beam_b_point, compute_frames, rigid_point, tip_row
 
 
 @nb.njit(**JIT)
@@ -79,34 +80,20 @@ def assemble_inertia(q, qd, P, tab, rec, mat, vec):
     """Fill M (mat[MAT_M]), h (vec[VEC_H]) and gravity (vec[VEC_Q]); return V_gravity.
 
     M (g, g cm, g cm^2 by coordinate), h = sum m J^T kappa and
-    Q_gravity = sum m J^T (0, -g) (dyn, dyn cm).  Only the upper triangle is
-    summed, then mirrored.  Returns the gravitational energy sum m g y (erg).
+    Q_gravity = sum m J^T (0, -g) (dyn, dyn cm), summed frame by frame
+    (:mod:`workbench.core.inertia`): the upper triangle, then mirrored.
+    Returns the gravitational energy sum m g y (erg).
     """
     M = mat[ly.MAT_M]
     h = vec[ly.VEC_H]
     Q = vec[ly.VEC_Q]
-    g = P[ly.P_GRAV]
     for i in range(ly.N_DOF):
         h[i] = 0.0
         Q[i] = 0.0
         for j in range(ly.N_DOF):
             M[i, j] = 0.0
     compute_frames(q, qd, P, tab, rec)
-    pt = rec[ly.REC_POINT]
-    v_grav = 0.0
-    for k in range(n_elements(P)):
-        m, rot, _ = element(k, q, qd, P, tab, rec)
-        for i in range(ly.N_DOF):
-            mjx = m * pt[ly.JX + i]
-            mjy = m * pt[ly.JY + i]
-            ra = rot * pt[ly.AA + i]
-            if mjx == 0.0 and mjy == 0.0 and ra == 0.0:
-                continue
-            for j in range(i, ly.N_DOF):
-                M[i, j] += mjx * pt[ly.JX + j] + mjy * pt[ly.JY + j] + ra * pt[ly.AA + j]
-            h[i] += mjx * pt[ly.KX] + mjy * pt[ly.KY]
-            Q[i] -= mjy * g
-        v_grav += m * g * pt[ly.RY]
+    v_grav = frame_sums(q, qd, P, tab, rec, M, h, Q)
     for i in range(ly.N_DOF):
         for j in range(i):
             M[i, j] = M[j, i]

@@ -150,7 +150,8 @@ REC_JOINT = 0    # joint frame: origin beam A's tip, angle alpha3 = phi_A
 REC_LOOSE = 1    # loose-body frame: origin d = (x_in + s, v), angle phi_A + psi
 REC_LOCAL = 2    # a point in a frame, before it is carried to global
 REC_POINT = 3    # the current point, global
-N_RECS = 4
+REC_ACC = 4      # sums over a frame's points (workbench.core.inertia)
+N_RECS = 5
 
 # --- work matrices and vectors -----------------------------------------------
 KC_K, KC_C = 0, 1                # kc (2, 9, 9): stiffness, damping
