@@ -138,6 +138,11 @@ def test_an_unstable_point_is_recorded_as_failed(tmp_path):
     table = W.run_study(S.load(write(tmp_path, text)), tmp_path / "res", jobs=1, progress=False)
     assert table.status.tolist() == ["failed"]
     assert table.message.iloc[0]
+    # a grid with no finished point still gets its tables, and the partial series its figures
+    make_report(S.load(tmp_path / "study.toml"), tmp_path / "res")
+    out = tmp_path / "res" / "small"
+    assert pd.read_csv(out / "tables" / "response.csv").status.tolist() == ["failed"]
+    assert (out / "figures" / f"time_history_{table.key.iloc[0][:8]}.png").exists()
 
 
 def test_stepped_sweep_carries_the_state(tmp_path):

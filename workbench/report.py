@@ -51,12 +51,16 @@ def _series_figures(study: Study, table: pd.DataFrame, out: Path) -> dict[str, o
     figs = {}
     for _, row in table.iterrows():
         path = out / "series" / f"{row.key}.parquet"
-        if row.status != "ok" or not path.exists():
+        if not path.exists():
             continue
         sig = pd.read_parquet(path)
         ev = pd.read_parquet(path.with_suffix(".events.parquet"))
-        title = point_title(row)
         t_end = float(sig.index[-1])
+        title = point_title(row)
+        if row.direction:
+            title += f", {row.direction} sweep"
+        if row.status != "ok":                     # what was computed before the failure
+            title += f" — {row.status} at t = {t_end:.2f} s"
         tag = row.key[:8]
         figs[f"time_history_{tag}"] = lambda s=sig, r=row, ti=title: F.time_history(
             s, r.static_tip_y, ti, seconds=min(0.5, study.window_s))

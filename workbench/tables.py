@@ -74,7 +74,8 @@ def latex_text(text: str) -> str:
 
 def _long(table: pd.DataFrame, columns: dict) -> pd.DataFrame:
     axes = [c for c in table.columns if c.startswith("axis_")]
-    keep = axes + ["status", "steady", "steady_change"] + [c for c in columns if c in table]
+    keep = axes + [c for c in ("status", "message", "steady", "steady_change", *columns)
+                   if c in table]
     return table[keep].rename(columns={c: c[5:] for c in axes})
 
 
