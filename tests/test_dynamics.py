@@ -154,3 +154,26 @@ def test_trajectory_agrees_with_solve_ivp_reference(fixed, duration):
     y_ref, _ = ref.integrate(y0, tr.t, rtol=1e-9, atol=1e-12)
     scale = np.max(np.abs(y_ref[:, :9]))
     assert np.max(np.abs(tr.q - y_ref[:, :9])) < 1e-6 * scale
+
+
+@pytest.mark.parametrize("tip", [True, False])
+@pytest.mark.parametrize("seed", range(3))
+def test_frame_sums_equal_the_element_sums(seed, tip):
+    """core/inertia.py regroups sum m J^T J + I a a^T, sum m J^T kappa and gravity by frame:
+    equal to the sums over the elements (kinematics of tests/test_kinematics.py) to round-off."""
+    from test_kinematics import kinematics
+
+    p = Parameters(tip_mass=tip)
+    model, work = mdl.build(p), mdl.make_work()
+    y = random_state(np.random.default_rng(seed))
+    v = eval_inertia(y[:9], y[9:], *model, *work)
+    k = kinematics(model, y[:9], y[9:])
+    m, J, a = k["mass"], k["J"], k["a"]
+    M = np.einsum("k,kri,krj->ij", m, J, J) + np.einsum("k,ki,kj->ij", k["rot"], a, a)
+    h = np.einsum("k,kri,kr->i", m, J, k["kap"])
+    Q = -model.P[ly.P_GRAV] * np.einsum("k,ki->i", m, J[:, 1])
+    np.testing.assert_allclose(work.mat[ly.MAT_M], M, rtol=1e-13, atol=1e-13 * np.abs(M).max())
+    assert np.abs(h).max() > 0.0                      # a moving state: h is not trivially zero
+    np.testing.assert_allclose(work.vec[ly.VEC_H], h, rtol=1e-12, atol=1e-12 * np.abs(h).max())
+    np.testing.assert_allclose(work.vec[ly.VEC_Q], Q, rtol=1e-13, atol=1e-13 * np.abs(Q).max())
+    assert v == pytest.approx(model.P[ly.P_GRAV] * np.dot(m, k["r"][:, 1]), rel=1e-13)
