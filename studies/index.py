@@ -24,7 +24,7 @@ def entry(results: Path, name: str) -> list[str]:
         info = json.loads(prov.read_text())
         runs = info.get("runs") or []
         if runs:
-            extra = f" Last sweep: {runs[-1]['points_run']} points in {runs[-1]['wall_s']:.0f} s wall."
+            extra = f" (last sweep: {runs[-1]['points_run']} points in {runs[-1]['wall_s']:.0f} s wall)"
     return [f"- [{title}]({page.relative_to(results)}): {first}{extra}"]
 
 

@@ -125,8 +125,10 @@ def render_index(study, table, figures, tables, out) -> str:
              "[provenance.json](provenance.json).", ""]
     failed = table[table.status != "ok"] if len(table) else table
     if len(failed):
-        lines += ["## Points that did not finish", "", "| point | status | reason |", "|---|---|---|"]
-        lines += [f"| {point_title(r)} | {r.status} | {r.message} |" for _, r in failed.iterrows()]
+        lines += ["## Points that did not finish", "",
+                  "| point | status | stopped at (s) | reason |", "|---|---|---|---|"]
+        lines += [f"| {point_title(r)} | {r.status} | {r.get('simulated_s', float('nan')):.3f} | "
+                  f"{r.message} |" for _, r in failed.iterrows()]
         lines.append("")
     lines += ["## Tables", ""]
     for p in tables:
