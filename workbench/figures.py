@@ -32,9 +32,8 @@ import pandas as pd  # noqa: E402
 from scipy import signal as sps  # noqa: E402
 
 from .metrics import CONTACT_CODES, QUANTITIES  # noqa: E402
+from .points import label, panels  # noqa: E402
 
-AXIS_LABELS = {"gap_mm": "gap (mm)", "freq_hz": "drive frequency (Hz)", "tip_mass": "tip mass",
-               "cork": "cork", "force_n": "force (N)", "mu": "friction coefficient"}
 CODE_COLORS = dict(zip(CONTACT_CODES, plt.get_cmap("tab10").colors))
 SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
                    ("strain2", "strain2 (-)"), ("accel1", "accel1 (cm/s²)"),
@@ -48,34 +47,6 @@ def save(fig, path: Path) -> list[Path]:
     for p in out:
         fig.savefig(p, dpi=120, bbox_inches="tight")
     plt.close(fig)
-    return out
-
-
-def label(axis: str) -> str:
-    return AXIS_LABELS.get(axis, axis)
-
-
-def axis_text(axis: str, value) -> str:
-    """'gap 1.016 mm', 'tip mass on', 'cork cubic' for a panel title."""
-    if isinstance(value, (bool, np.bool_)):
-        return f"{label(axis)} {'on' if value else 'off'}"
-    name = label(axis)
-    if name.endswith(")"):                      # 'gap (mm)' -> 'gap 1.016 mm'
-        base, unit = name[:-1].split(" (")
-        return f"{base} {value:g} {unit}"
-    return f"{name} {value}"
-
-
-def panels(table: pd.DataFrame, exclude: tuple[str, ...]) -> list[tuple[str, pd.DataFrame]]:
-    """Split the table by every axis not in ``exclude`` that takes several values."""
-    by = [c for c in table.columns if c.startswith("axis_") and c[5:] not in exclude
-          and table[c].nunique() > 1]
-    if not by:
-        return [("", table)]
-    out = []
-    for values, group in table.groupby(by, sort=True):
-        values = values if isinstance(values, tuple) else (values,)
-        out.append((", ".join(axis_text(c[5:], v) for c, v in zip(by, values)), group))
     return out
 
 
@@ -241,11 +212,9 @@ def switching_diagram(events: pd.DataFrame, t_end: float, title: str, seconds: f
     t0 = t_end - seconds
     t = events.t.to_numpy()
     codes = np.array([contact_code(int(r)) for r in events.to_regime])
-    keep = t >= t0
-    first = codes[keep.argmax() - 1] if keep.any() and keep.argmax() > 0 else \
-        (codes[-1] if len(codes) else 0)
-    tt = np.concatenate([[t0], t[keep], [t_end]])
-    cc = np.concatenate([[first], codes[keep], [codes[keep][-1] if keep.any() else first]])
+    start = max(np.searchsorted(t, t0, side="right") - 1, 0)     # the regime in force at t0
+    tt = np.concatenate([[t0], t[start + 1:], [t_end]])
+    cc = np.concatenate([codes[start:], codes[-1:]])
     level = {c: i for i, c in enumerate(CONTACT_CODES)}
     fig, ax = plt.subplots(figsize=(8, 3))
     ax.step(tt, [level[int(c)] for c in cc], where="post", lw=0.9)

@@ -11,8 +11,8 @@ from pathlib import Path
 _PACKAGE = Path(__file__).resolve().parent
 PACKAGES = ("numba", "numpy", "scipy", "pandas", "joblib", "pyarrow", "matplotlib")
 #: Modules that only present results: a change to them keeps computed points valid.
-PRESENTATION = frozenset({"figures.py", "tables.py", "report.py", "cli.py", "__main__.py",
-                          "provenance.py"})
+PRESENTATION = frozenset({"figures.py", "tables.py", "report.py", "points.py", "cli.py",
+                          "__main__.py", "provenance.py"})
 
 
 @functools.lru_cache(maxsize=1)

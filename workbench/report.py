@@ -14,6 +14,7 @@ spectrogram as well.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import time
 from pathlib import Path
@@ -21,14 +22,10 @@ from pathlib import Path
 import pandas as pd
 
 from . import figures as F
+from .points import point_title
 from .provenance import environment
 from .study import Study
 from .tables import write_tables
-
-
-def point_title(row) -> str:
-    """'gap 1.016 mm, 20 Hz, ...' from a points-table row's axis values."""
-    return ", ".join(F.axis_text(k[5:], v) for k, v in row.items() if k.startswith("axis_"))
 
 
 def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
@@ -47,8 +44,8 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     return figs
 
 
-def _series_figures(study: Study, table: pd.DataFrame, out: Path) -> dict[str, object]:
-    figs = {}
+def _series_figures(study: Study, table: pd.DataFrame, out: Path):
+    """(name, figure builder) per saved series, one point's series in memory at a time."""
     for _, row in table.iterrows():
         path = out / "series" / f"{row.key}.parquet"
         if not path.exists():
@@ -62,15 +59,12 @@ def _series_figures(study: Study, table: pd.DataFrame, out: Path) -> dict[str, o
         if row.status != "ok":                     # what was computed before the failure
             title += f" — {row.status} at t = {t_end:.2f} s"
         tag = row.key[:8]
-        figs[f"time_history_{tag}"] = lambda s=sig, r=row, ti=title: F.time_history(
-            s, r.static_tip_y, ti, seconds=min(0.5, study.window_s))
-        figs[f"strain_spectra_{tag}"] = lambda s=sig, ti=title: F.strain_spectra(
-            s, ti, seconds=study.window_s)
-        figs[f"switching_{tag}"] = lambda e=ev, te=t_end, ti=title: F.switching_diagram(
-            e, te, ti, seconds=min(0.5, study.window_s))
+        short = min(0.5, study.window_s)
+        yield f"time_history_{tag}", lambda: F.time_history(sig, row.static_tip_y, title, short)
+        yield f"strain_spectra_{tag}", lambda: F.strain_spectra(sig, title, study.window_s)
+        yield f"switching_{tag}", lambda: F.switching_diagram(ev, t_end, title, short)
         if study.excitation["kind"] == "chirp":
-            figs[f"spectrogram_{tag}"] = lambda s=sig, ti=title: F.spectrogram(s, ti)
-    return figs
+            yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
 
 
 def make_report(study: Study, results: str | Path = "results") -> Path:
@@ -79,7 +73,9 @@ def make_report(study: Study, results: str | Path = "results") -> Path:
     table = pd.read_parquet(out / "points.parquet")
     t0 = time.perf_counter()
     made = {}
-    for name, build in {**_grid_figures(study, table), **_series_figures(study, table, out)}.items():
+    builders = itertools.chain(_grid_figures(study, table).items(),
+                               _series_figures(study, table, out))
+    for name, build in builders:
         made[name] = F.save(build(), out / "figures" / name)
     tables = write_tables(table, out / "tables")
     report_wall = time.perf_counter() - t0

@@ -21,6 +21,7 @@ from pathlib import Path
 import pandas as pd
 
 from .metrics import CONTACT_CODES, QUANTITIES
+from .points import label, panels
 
 TABLES = {
     "response": {k: QUANTITIES[k] for k in ("tip_rms", "tip_h1", "strain1_rms", "accel3_rms")},
@@ -32,12 +33,11 @@ PIVOT = ("gap_mm", "freq_hz")
 
 
 def with_dominant_code(table: pd.DataFrame) -> pd.DataFrame:
-    """Add ``dominant_code``: the contact code with the largest time share."""
-    shares = table[[f"share_{c}" for c in CONTACT_CODES]]
-    out = table.copy()
-    out["dominant_code"] = [int(c.split("_")[1]) if pd.notna(v) else pd.NA
-                            for c, v in zip(shares.fillna(-1).idxmax(axis=1), shares.max(axis=1))]
-    return out
+    """Add ``dominant_code``: the contact code with the largest time share (NA if none)."""
+    shares = table[[f"share_{c}" for c in CONTACT_CODES if f"share_{c}" in table]]
+    codes = [pd.NA if row.isna().all() else int(row.idxmax().split("_")[1])
+             for _, row in shares.iterrows()] if len(shares.columns) else pd.NA
+    return table.assign(dominant_code=codes)
 
 
 def cell(row, quantity: str) -> str:
@@ -51,8 +51,6 @@ def cell(row, quantity: str) -> str:
 
 def pivots(table: pd.DataFrame, quantity: str) -> list[tuple[str, pd.DataFrame]]:
     """(block title, gap x frequency frame of printed cells) per value of the other axes."""
-    from .figures import label, panels
-
     out = []
     for title, part in panels(table, PIVOT):
         grid = pd.DataFrame({
@@ -82,11 +80,7 @@ def _long(table: pd.DataFrame, columns: dict) -> pd.DataFrame:
 def write_tables(table: pd.DataFrame, out: Path) -> list[Path]:
     """Write every table of the module docstring under ``out``; return the paths."""
     out.mkdir(parents=True, exist_ok=True)
-    ok = table.status == "ok"
-    if ok.any():
-        table = with_dominant_code(table)
-    else:
-        table = table.assign(dominant_code=pd.NA)
+    table = with_dominant_code(table)
     pivotable = all(f"axis_{a}" in table for a in PIVOT)
     written = []
     for name, columns in TABLES.items():
