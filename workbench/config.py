@@ -47,3 +47,7 @@ EVENT_TIME_TOL = 1e-11
 #: More events than this inside one integration step end the run
 #: (a Zeno-like accumulation of impacts or regime switches).
 MAX_EVENTS_PER_STEP = 64
+
+#: Options of the kernels that split independent work over the cores with
+#: ``numba.prange`` (the cork fit's exhaustive search).
+JIT_PARALLEL = dict(JIT, parallel=True)
