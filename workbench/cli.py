@@ -5,6 +5,9 @@
                   [--force-n A] [--mu M] [--duration T] [--dt DT] [--out FILE.parquet] [--json]
     workbench modes [--tip-mass on|off] [--joint locked|free] [--cork MODEL] [--json]
     workbench params [--json]
+    workbench compare FILE [model and drive options] [--skip-s S] [--out DIR]
+    workbench estimate FILE... --fit NAME=START ... [model and drive options]
+    workbench identify tables [--out DIR] | identify decrement X1 XN T1 TN N [--beam a|b]
 
 Every subcommand accepts ``--params FILE.toml`` and ``--set NAME=VALUE``
 (repeatable; unit-suffixed names such as ``gap_mm`` are converted).
@@ -170,6 +173,149 @@ def _cmd_report(args) -> int:
     return 0
 
 
+def _add_drive_options(parser, ramp_default=None) -> None:
+    drive = parser.add_argument_group("excitation (one; default none)")
+    drive.add_argument("--freq-hz", type=float, help="sine at force1, frequency (Hz)")
+    drive.add_argument("--chirp", type=_chirp, metavar="F0:F1:T", help="linear chirp F0 -> F1 Hz over T s")
+    drive.add_argument("--free-decay", type=float, metavar="CM",
+                       help="release from a static tip deflection (cm, + up)")
+    drive.add_argument("--impulse", choices=("joint", "tip"),
+                       help="half-sine hammer: vertical at the joint body, or axial at the tip")
+    drive.add_argument("--force-n", type=float,
+                       help="shaker amplitude or hammer peak (N); default: see README")
+    drive.add_argument("--ramp-s", type=float, default=ramp_default,
+                       help="soft-start ramp of sine/chirp (s)")
+    drive.add_argument("--pulse-s", type=float, default=1e-3, help="hammer pulse duration (s)")
+    drive.add_argument("--hit-s", type=float, default=0.01, help="hammer pulse start (s)")
+
+
+def _record_settings(args, meta: dict) -> dict:
+    """A record's settings (matching.py): the file's, overridden by the command line."""
+    settings = dict(meta)
+    given = {"gap_mm": args.gap_mm, "tip_mass": args.tip_mass, "cork": args.cork}
+    settings.update({k: v for k, v in given.items() if v is not None})
+    if args.mu is not None:
+        settings.update(mu_s=args.mu, mu_k=args.mu)
+    for item in args.set:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise ParameterError(f"--set expects NAME=VALUE, got {item!r}")
+        settings[name.strip()] = _value(text.strip())
+    drive = {}
+    if args.freq_hz is not None:
+        drive = {"drive": "sine", "freq_hz": args.freq_hz}
+    elif args.chirp is not None:
+        drive = dict(zip(("drive", "f0_hz", "f1_hz", "sweep_s"), ("chirp", *args.chirp)))
+    elif args.free_decay is not None:
+        drive = {"drive": "free_decay", "deflection_cm": args.free_decay}
+    elif args.impulse is not None:
+        drive = {"drive": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
+    if drive:
+        for key in [k for k in settings if k in ("drive", "freq_hz", "f0_hz", "f1_hz", "sweep_s",
+                                                  "deflection_cm", "width_s", "t_hit_s")]:
+            del settings[key]
+        settings.update(drive)
+    if args.force_n is not None:
+        settings["force_n"] = args.force_n
+    if args.ramp_s is not None and settings.get("drive") in ("sine", "chirp"):
+        settings["ramp_s"] = args.ramp_s
+    return settings
+
+
+def _read_record(args, path):
+    from .expfiles import read
+    scale = {}
+    for item in args.strain_scale:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise ParameterError(f"--strain-scale expects CHANNEL=STRAIN_PER_VOLT, got {item!r}")
+        scale[name.strip().lower()] = float(text)
+    return read(path, strain_scale=scale)
+
+
+def _add_record_options(parser) -> None:
+    parser.add_argument("--params", metavar="FILE.toml", help="base parameters from a TOML file")
+    parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
+                        help="set one parameter (repeatable), e.g. --set e_b_gpa=46.12")
+    parser.add_argument("--tip-mass", type=_on_off, metavar="on|off", help="the tip mass")
+    parser.add_argument("--cork", choices=sorted(CORK_MODELS), help="cork model (MODEL.md §6)")
+    parser.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
+    parser.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
+    _add_drive_options(parser)
+    parser.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
+                        help="scale factor of a strain channel recorded in V (strain per volt)")
+    parser.add_argument("--skip-s", type=float, default=0.0,
+                        help="leave out the first seconds (the transient)")
+
+
+def _cmd_compare(args) -> int:
+    from .compare import compare
+    from .matching import setup_from
+
+    record = _read_record(args, args.file)
+    base = Parameters.from_toml(args.params) if args.params else None
+    setup = setup_from(_record_settings(args, record.attrs["meta"]), record, base)
+    run = setup.simulate()
+    out = Path(args.out or Path("results") / "compare" / Path(args.file).stem)
+    title = f"{Path(args.file).name} vs simulation ({setup.excitation['kind']})"
+    result = compare(record, run, out, skip_s=args.skip_s, threshold=args.threshold,
+                     chirp=setup.excitation["kind"] == "chirp", title=title)
+    print(json.dumps({"record": args.file, "simulation_status": run.status, "out": str(out),
+                      "figures": [str(p) for p in result.figures if p.suffix == ".png"],
+                      "rms_error_rel": dict(zip(result.signals.channel,
+                                                result.signals.rms_error_rel.round(4)))}))
+    return 0 if run.ok else 1
+
+
+def _cmd_estimate(args) -> int:
+    from .estimate import estimate
+    from .matching import setup_from
+
+    start = {}
+    for item in args.fit:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise ParameterError(f"--fit expects NAME=START, got {item!r}")
+        start[name.strip()] = float(text)
+    base = Parameters.from_toml(args.params) if args.params else None
+    pairs = []
+    for path in args.files:
+        record = _read_record(args, path)
+        pairs.append((record, setup_from(_record_settings(args, record.attrs["meta"]), record, base)))
+    fit = estimate(pairs, start, skip_s=args.skip_s, jobs=args.jobs, max_nfev=args.max_nfev)
+    table = fit.table()
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        table.to_csv(args.out, index=False)
+    print(json.dumps({"values": fit.values, "intervals_2sigma": fit.intervals, "cost": fit.cost,
+                      "simulations": fit.n_simulations, "success": fit.success,
+                      "message": fit.message, "wall_s": round(fit.wall_s, 1)}))
+    return 0 if fit.success else 1
+
+
+def _cmd_identify_tables(args) -> int:
+    from .identify import tables
+
+    built = tables.build(include_table6=not args.no_table6)
+    paths = tables.write(built, args.out)
+    agree = {title: dict(t.agrees.value_counts()) for title, t in built.items()}
+    print(json.dumps({"markdown": str(paths["md"]), "latex": str(paths["tex"]),
+                      "agreement": {k: {str(a): int(n) for a, n in v.items()} for k, v in agree.items()}}))
+    return 0
+
+
+def _cmd_identify_decrement(args) -> int:
+    from .identify import log_decrement
+
+    p = _parameters(args)
+    beam = {} if args.beam is None else dict(
+        mu=p.mu_a if args.beam == "a" else p.mu_b, length=p.l_a if args.beam == "a" else p.l_b,
+        area_moment=p.inertia_a if args.beam == "a" else p.inertia_b)
+    d = log_decrement(args.x1, args.xn, args.t1, args.tn, args.n, **beam)
+    print(json.dumps({**d._asdict(), "E_gpa": d.E_gpa}))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="workbench", description="Loose bolted lap joint workbench (9-DOF Gibbs-Appell model).")
@@ -187,18 +333,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_model_options(run)
     run.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
     run.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
-    drive = run.add_argument_group("excitation (one; default none)")
-    drive.add_argument("--freq-hz", type=float, help="sine at force1, frequency (Hz)")
-    drive.add_argument("--chirp", type=_chirp, metavar="F0:F1:T", help="linear chirp F0 -> F1 Hz over T s")
-    drive.add_argument("--free-decay", type=float, metavar="CM",
-                       help="release from a static tip deflection (cm, + up)")
-    drive.add_argument("--impulse", choices=("joint", "tip"),
-                       help="half-sine hammer: vertical at the joint body, or axial at the tip")
-    drive.add_argument("--force-n", type=float,
-                       help="shaker amplitude or hammer peak (N); default: see README")
-    drive.add_argument("--ramp-s", type=float, default=1.0, help="soft-start ramp of sine/chirp (s)")
-    drive.add_argument("--pulse-s", type=float, default=1e-3, help="hammer pulse duration (s)")
-    drive.add_argument("--hit-s", type=float, default=0.01, help="hammer pulse start (s)")
+    _add_drive_options(run, ramp_default=1.0)
     run.add_argument("--duration", type=float, default=1.0, help="simulated time (s)")
     run.add_argument("--dt", type=float, help="RK4 step (s); default from the model's fastest mode")
     run.add_argument("--output-hz", type=float, default=1000.0, help="sample rate of the signals")
@@ -224,6 +359,40 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("study", help="study definition (TOML)")
     report.add_argument("--results", default="results", help="results root (default results/)")
     report.set_defaults(func=_cmd_report)
+
+    compare = sub.add_parser("compare", help="a measurement file against the matching simulation")
+    compare.add_argument("file", help="a .lvm or tab-delimited record (Table 2 channels)")
+    _add_record_options(compare)
+    compare.add_argument("--threshold", type=float, default=0.5,
+                         help="contact patch voltage that counts as touched (V)")
+    compare.add_argument("--out", help="output folder (default results/compare/<file stem>)")
+    compare.set_defaults(func=_cmd_compare)
+
+    est = sub.add_parser("estimate", help="fit model parameters to measurement files (§7.2)")
+    est.add_argument("files", nargs="+", help="records (.lvm or tab-delimited)")
+    est.add_argument("--fit", metavar="NAME=START", action="append", required=True,
+                     help="a parameter to fit and its start (CGS; force_n in N), repeatable; "
+                          "fittable: e_a, e_b, zeta_a, zeta_b, mu, cork_k, cork_c, force_n")
+    _add_record_options(est)
+    est.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
+    est.add_argument("--max-nfev", type=int, default=30, help="most residual evaluations")
+    est.add_argument("--out", metavar="FILE.csv", help="write the fitted values")
+    est.set_defaults(func=_cmd_estimate)
+
+    ident = sub.add_parser("identify", help="the paper's parameter identification (§4)")
+    isub = ident.add_subparsers(dest="what", required=True)
+    tab = isub.add_parser("tables", help="Tables 3-6 and Appendix B from their raw inputs")
+    tab.add_argument("--out", default="results/identify", help="output folder")
+    tab.add_argument("--no-table6", action="store_true", help="skip Table 6's fits (~40 s)")
+    tab.set_defaults(func=_cmd_identify_tables)
+    dec = isub.add_parser("decrement", help="Td, zeta, omega_n (and EI, E) from two peaks")
+    for name, kind_, text in (("x1", float, "first peak"), ("xn", float, "n-th peak"),
+                              ("t1", float, "time of the first (s)"), ("tn", float, "time of the n-th (s)"),
+                              ("n", int, "number of peaks")):
+        dec.add_argument(name, type=kind_, help=text)
+    dec.add_argument("--beam", choices=("a", "b"), help="give EI and E with this beam's mu, L, I")
+    _add_model_options(dec)
+    dec.set_defaults(func=_cmd_identify_decrement)
 
     params = sub.add_parser("params", help="list every parameter with its unit, range and source")
     _add_model_options(params)

@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from scipy import signal as sps  # noqa: E402
 
-from .metrics import CONTACT_CODES, QUANTITIES  # noqa: E402
+from .metrics import CONTACT_CODES, QUANTITIES, psd  # noqa: E402
 from .points import label, panels  # noqa: E402
 
 CODE_COLORS = dict(zip(CONTACT_CODES, plt.get_cmap("tab10").colors))
@@ -190,11 +190,9 @@ def strain_spectra(signals: pd.DataFrame, title: str, seconds: float | None = No
     """Power spectral density of strain1 and strain2 (Welch, 1 s segments; Fig. 7-8)."""
     s = _window(signals, seconds)
     t = s.index.to_numpy()
-    fs = 1.0 / np.median(np.diff(t))
     fig, ax = plt.subplots(figsize=(8, 3.5))
     for ch in ("strain1", "strain2"):
-        f, p = sps.welch(s[ch].to_numpy(), fs=fs, nperseg=min(len(t), int(round(fs))),
-                         detrend="constant")
+        f, p = psd(t, s[ch].to_numpy())
         keep = f <= fmax
         ax.semilogy(f[keep], p[keep], lw=0.9, label=ch)
     ax.set_xlabel("frequency (Hz)")
@@ -243,4 +241,56 @@ def spectrogram(signals: pd.DataFrame, title: str, channel: str = "strain1",
     ax.set_xlabel("time (min)")
     ax.set_ylabel("frequency (Hz)")
     ax.set_title(title, fontsize=9)
+    return fig
+
+
+# --- comparison of a simulation with a record (``workbench compare``, seed §6) ---------
+def overlay_time_history(records: dict[str, pd.DataFrame], channels, title: str,
+                         seconds: float = 0.5):
+    """The last ``seconds`` of each channel, one line per source (paper Fig. 6)."""
+    fig, axes = plt.subplots(len(channels), 1, figsize=(8, 1.7 * len(channels)), sharex=True,
+                             squeeze=False)
+    for ax, ch in zip(axes[:, 0], channels):
+        for name, rec in records.items():
+            s = _window(rec, seconds)
+            ax.plot(s.index.to_numpy(), s[ch].to_numpy(), lw=0.8, label=name)
+        ax.set_ylabel(ch, fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=7, loc="upper right")
+    axes[0, 0].set_title(title, fontsize=9)
+    axes[-1, 0].set_xlabel("time (s)")
+    return fig
+
+
+def overlay_spectra(records: dict[str, pd.DataFrame], channels, title: str, fmax: float = 250.0):
+    """Power spectra of each channel, one line per source (paper Fig. 7-8)."""
+    fig, axes = _grid(len(channels), width=4.6, height=3.0)
+    for ax, ch in zip(axes, channels):
+        for name, rec in records.items():
+            f, p = psd(rec.index.to_numpy(), rec[ch].to_numpy())
+            keep = f <= fmax
+            ax.semilogy(f[keep], p[keep], lw=0.8, label=name)
+        ax.set_title(ch, fontsize=9)
+        ax.set_xlabel("frequency (Hz)")
+        ax.grid(alpha=0.3, which="both")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(title, fontsize=9)
+    return fig
+
+
+def code_series_diagrams(codes: dict[str, pd.Series], title: str, seconds: float = 0.5):
+    """Contact code against time, one panel per source (paper Fig. 9-10)."""
+    level = {c: i for i, c in enumerate(CONTACT_CODES)}
+    fig, axes = plt.subplots(len(codes), 1, figsize=(8, 2.4 * len(codes)), sharex=True,
+                             squeeze=False)
+    for ax, (name, series) in zip(axes[:, 0], codes.items()):
+        t = series.index.to_numpy()
+        keep = t >= t[-1] - seconds
+        ax.step(t[keep], [level.get(int(c), 0) for c in series.to_numpy()[keep]], where="post",
+                lw=0.9)
+        ax.set_yticks(range(len(CONTACT_CODES)), [str(c) for c in CONTACT_CODES])
+        ax.set_ylabel(f"{name}\npoints in contact", fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_title(title, fontsize=9)
+    axes[-1, 0].set_xlabel("time (s)")
     return fig

@@ -51,6 +51,38 @@ QUANTITIES = {
 STEADY_TOL = 0.05
 
 
+def psd(t: np.ndarray, x: np.ndarray, segment_s: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Power spectral density of x (unit^2/Hz) by Welch's method with ``segment_s``
+    segments (Hann, half overlap, mean removed): frequencies (Hz) and PSD."""
+    from scipy.signal import welch
+
+    fs = 1.0 / float(np.median(np.diff(t)))
+    return welch(np.asarray(x, dtype=float), fs=fs, nperseg=min(len(t), int(round(segment_s * fs))),
+                 detrend="constant")
+
+
+def spectral_peaks(f: np.ndarray, p: np.ndarray, n: int = 3, fmin: float = 1.0,
+                   fmax: float = 250.0, min_prominence: float = 0.5) -> np.ndarray:
+    """Frequencies (Hz) of the ``n`` most prominent PSD peaks in [fmin, fmax] standing
+    ``min_prominence`` decades above their surroundings (noise makes many small
+    ones), refined by a parabola through the peak bin and its neighbours; ascending."""
+    from scipy.signal import find_peaks
+
+    band = np.flatnonzero((f >= fmin) & (f <= fmax))
+    if len(band) < 3:
+        return np.array([])
+    logp = np.log10(p[band] + 1e-300)
+    idx, props = find_peaks(logp, prominence=min_prominence)
+    idx = idx[np.argsort(-props["prominences"])][:n]
+    out = []
+    for i in idx:
+        a, b, c = logp[i - 1], logp[i], logp[i + 1]
+        den = a - 2.0 * b + c
+        shift = 0.5 * (a - c) / den if den != 0.0 else 0.0
+        out.append(f[band][i] + shift * (f[1] - f[0]))
+    return np.sort(np.array(out))
+
+
 def harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> dict[float, float]:
     """Amplitudes of x at k f_hz (k in HARMONICS) by least squares with a constant term."""
     cols = [np.ones_like(t)]

@@ -66,6 +66,23 @@ class StudyError(ParameterError):
     """A study file that cannot run (names the file, the key and what is allowed)."""
 
 
+def excitation_array(excitation: dict, first_in_chain: bool = True) -> np.ndarray:
+    """The kernel's excitation array of settings {"kind": ..., key: value} (user units,
+    every key of its kind present); a sine or chirp not first in a chain has no ramp."""
+    e = dict(excitation)
+    kind = e.pop("kind")
+    if kind in ("sine", "chirp") and not first_in_chain:
+        e["ramp_s"] = 0.0
+    if kind == "none" or kind == "free_decay":
+        return X.none()
+    if kind == "sine":
+        return X.sine(e["force_n"], e["freq_hz"], e["ramp_s"])
+    if kind == "chirp":
+        return X.chirp(e["force_n"], e["f0_hz"], e["f1_hz"], e["sweep_s"], e["ramp_s"])
+    builder = X.hammer_joint if kind == "hammer_joint" else X.hammer_tip
+    return builder(e["force_n"], e["width_s"], e["t_hit_s"])
+
+
 @dataclass(frozen=True)
 class Point:
     """One grid point: its axis values, the model parameters and the excitation settings."""
@@ -79,18 +96,7 @@ class Point:
 
     def excitation_array(self, first_in_chain: bool = True) -> np.ndarray:
         """The kernel's excitation array (the soft start only on a chain's first point)."""
-        e = dict(self.excitation)
-        kind = e.pop("kind")
-        if kind in ("sine", "chirp") and not first_in_chain:
-            e["ramp_s"] = 0.0
-        if kind == "none" or kind == "free_decay":
-            return X.none()
-        if kind == "sine":
-            return X.sine(e["force_n"], e["freq_hz"], e["ramp_s"])
-        if kind == "chirp":
-            return X.chirp(e["force_n"], e["f0_hz"], e["f1_hz"], e["sweep_s"], e["ramp_s"])
-        builder = X.hammer_joint if kind == "hammer_joint" else X.hammer_tip
-        return builder(e["force_n"], e["width_s"], e["t_hit_s"])
+        return excitation_array(self.excitation, first_in_chain)
 
     @property
     def free_decay_cm(self):

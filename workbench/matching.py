@@ -1,0 +1,74 @@
+"""The simulation that matches a record: its model parameters, excitation and length.
+
+A record's settings come from its file (``WB_`` keys, :mod:`workbench.expfiles`)
+and from the command line, which wins.  The keys are those of a study
+(:mod:`workbench.study`): ``drive`` (the excitation kind: sine, chirp,
+free_decay, hammer_joint, hammer_tip, none) with its settings (``freq_hz``,
+``force_n``, ``ramp_s``, ``f0_hz``, ``f1_hz``, ``sweep_s``,
+``deflection_cm``, ``width_s``, ``t_hit_s``), and any model parameter of
+``workbench params`` (``gap_mm``, ``tip_mass``, ``cork``, ``e_b_gpa``, ...).
+The duration and sample rate are the record's.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .params import ParameterError, Parameters, resolve_name
+from .study import EXCITATION_DEFAULTS, EXCITATION_KEYS, excitation_array
+
+
+@dataclass(frozen=True)
+class Setup:
+    """One simulation: parameters, excitation settings (user units), length (s), rate (Hz)."""
+
+    params: Parameters
+    excitation: dict
+    duration: float
+    output_hz: float
+
+    def simulate(self, params: Parameters | None = None, excitation: dict | None = None):
+        """Run it (optionally with other parameters or excitation settings)."""
+        from .simulate import simulate
+
+        exc = excitation or self.excitation
+        free = exc.get("deflection_cm") if exc["kind"] == "free_decay" else None
+        return simulate(params or self.params, excitation_array(exc), self.duration,
+                        output_hz=self.output_hz, free_decay_cm=free)
+
+    def meta(self, model_keys: dict) -> dict:
+        """The ``WB_`` settings to write with a simulated record of this setup."""
+        exc = dict(self.excitation)
+        return {"drive": exc.pop("kind"), **exc, **model_keys}
+
+
+def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = None) -> Setup:
+    """The Setup of ``record`` from its settings (module docstring)."""
+    settings = dict(settings)
+    kind = settings.pop("drive", "none")
+    if kind not in EXCITATION_KEYS:
+        raise ParameterError(f"drive = {kind!r}: use one of {', '.join(EXCITATION_KEYS)}")
+    exc = {"kind": kind}
+    for key in EXCITATION_KEYS[kind]:
+        if key in settings:
+            exc[key] = float(settings.pop(key))
+        elif key in EXCITATION_DEFAULTS:
+            exc[key] = EXCITATION_DEFAULTS[key]
+        else:
+            raise ParameterError(f"a {kind} drive needs {key} (in the file as WB_{key}, or "
+                                 "on the command line)")
+    for key in [k for k in settings if k in set().union(*EXCITATION_KEYS.values())]:
+        raise ParameterError(f"{key} does not apply to a {kind} drive")
+    for key in settings:
+        resolve_name(key)                 # names the parameter if it is unknown
+    params = (base or Parameters()).replace(**settings) if settings else (base or Parameters())
+    t = record.index.to_numpy(dtype=float)
+    rate = 1.0 / float(np.median(np.diff(t)))
+    output_hz = float(round(rate))
+    if abs(output_hz - rate) > 1e-6 * rate:
+        raise ParameterError(f"the record's sample rate {rate} Hz is not a whole number of Hz")
+    duration = round(float(t[-1] - t[0]) * output_hz) / output_hz
+    excitation_array(exc)                 # validates the values
+    return Setup(params, exc, duration, output_hz)
