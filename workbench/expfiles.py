@@ -198,6 +198,8 @@ def read_lvm(path, strain_scale: dict | None = None) -> pd.DataFrame:
         first_data = first_data or i + 1
         rows, i = _data_rows(path, lines, i, sep, decimal, ["X_Value"] * (x_columns == "One")
                              + [TABLE2_NAMES[c] for c in channels])
+        if not rows:
+            raise ExperimentFileError(path, names_line + 1, "no data rows after the column names")
         declared = _per_channel(path, seg_line, seg, "Samples", n_ch)
         if any(d and int(float(d)) != len(rows) for d in declared):
             raise ExperimentFileError(path, seg_line, f"the segment declares {declared[0]} samples "
@@ -341,6 +343,8 @@ def read_tab(path, strain_scale: dict | None = None) -> pd.DataFrame:
     assumed = [c for c, (_, u) in zip(channels, labels[1:]) if u is None]
     rows, end = _data_rows(path, lines, i + 1, "\t", ".", [labels[0][0]]
                            + [TABLE2_NAMES[c] for c in channels])
+    if not rows:
+        raise ExperimentFileError(path, i + 2, "no data rows after the header line")
     if any(line.strip() for line in lines[end:]):
         extra = end + next(k for k, line in enumerate(lines[end:]) if line.strip())
         raise ExperimentFileError(path, extra + 1, "text after a blank line ends the data")

@@ -62,17 +62,20 @@ def psd(t: np.ndarray, x: np.ndarray, segment_s: float = 1.0) -> tuple[np.ndarra
 
 
 def spectral_peaks(f: np.ndarray, p: np.ndarray, n: int = 3, fmin: float = 1.0,
-                   fmax: float = 250.0, min_prominence: float = 0.5) -> np.ndarray:
+                   fmax: float = 250.0, min_prominence: float = 0.5,
+                   min_relative: float = 1e-4) -> np.ndarray:
     """Frequencies (Hz) of the ``n`` most prominent PSD peaks in [fmin, fmax] standing
-    ``min_prominence`` decades above their surroundings (noise makes many small
-    ones), refined by a parabola through the peak bin and its neighbours; ascending."""
+    ``min_prominence`` decades above their surroundings and within ``min_relative``
+    of the highest (measurement noise makes many small ones), refined by a parabola
+    through the peak bin and its neighbours; ascending."""
     from scipy.signal import find_peaks
 
     band = np.flatnonzero((f >= fmin) & (f <= fmax))
     if len(band) < 3:
         return np.array([])
     logp = np.log10(p[band] + 1e-300)
-    idx, props = find_peaks(logp, prominence=min_prominence)
+    idx, props = find_peaks(logp, prominence=min_prominence,
+                            height=float(logp.max()) + np.log10(min_relative))
     idx = idx[np.argsort(-props["prominences"])][:n]
     out = []
     for i in idx:
