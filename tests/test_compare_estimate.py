@@ -95,3 +95,16 @@ def test_matching_setup_refuses_bad_settings():
         setup_from({"drive": "chirp", "f0_hz": 5, "f1_hz": 65, "sweep_s": 1, "freq_hz": 3}, base)
     with pytest.raises(ParameterError, match="gap"):
         setup_from({"gap_mm": 9.0}, base)
+
+
+def test_compare_of_a_chirp_draws_both_spectrograms(tmp_path):
+    settings = {"drive": "chirp", "f0_hz": 5.0, "f1_hz": 65.0, "sweep_s": 2.0, "ramp_s": 0.2}
+    setup = setup_from(settings, _time_base(2.0))
+    run = setup.simulate()
+    path = F.write(tmp_path / "chirp.txt", F.record_from_run(run), settings)
+    out = tmp_path / "cmp"
+    assert main(["compare", str(path), "--out", str(out)]) == 0
+    for name in ("spectrogram_record", "spectrogram_simulation", "switching"):
+        assert (out / f"{name}.png").exists()
+    signals = pd.read_csv(out / "differences_signals.csv")
+    assert signals.rms_error_rel.max() < 1e-6      # the same model, no noise

@@ -174,7 +174,7 @@ def write(tables: dict[str, pd.DataFrame], out: str | Path) -> dict[str, Path]:
           "the fit's interval).", ""]
     tex = ["% Produced by `workbench identify tables`."]
     for title, table in tables.items():
-        md += [f"## {title}", "", table.to_markdown(index=False), ""]
+        md += [f"## {title}", "", table.to_markdown(index=False, disable_numparse=True), ""]
         tex += [table.to_latex(index=False, caption=title, escape=True).replace("§", r"\S{}")]
     md += ["## Notes", "", NOTES]
     paths = {"md": out / "identification.md", "tex": out / "identification.tex"}
