@@ -38,6 +38,17 @@ def _value(text: str):
         return text
 
 
+def _pairs(items: list[str], option: str, what: str = "VALUE") -> dict[str, str]:
+    """Repeated ``--option NAME=VALUE`` arguments as {name: text}."""
+    out = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise ParameterError(f"{option} expects NAME={what}, got {item!r}")
+        out[name.strip()] = text.strip()
+    return out
+
+
 def _add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--params", metavar="FILE.toml", help="parameters from a TOML file")
     parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
@@ -48,12 +59,7 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
 
 def _parameters(args) -> Parameters:
     p = Parameters.from_toml(args.params) if args.params else Parameters()
-    changes = {}
-    for item in args.set:
-        name, sep, text = item.partition("=")
-        if not sep:
-            raise ParameterError(f"--set expects NAME=VALUE, got {item!r}")
-        changes[name.strip()] = _value(text.strip())
+    changes = {name: _value(text) for name, text in _pairs(args.set, "--set").items()}
     if args.tip_mass is not None:
         changes["tip_mass"] = args.tip_mass
     if args.cork is not None:
@@ -191,16 +197,14 @@ def _add_drive_options(parser, ramp_default=None) -> None:
 
 def _record_settings(args, meta: dict) -> dict:
     """A record's settings (matching.py): the file's, overridden by the command line."""
+    from .study import ALL_EXCITATION_KEYS
+
     settings = dict(meta)
     given = {"gap_mm": args.gap_mm, "tip_mass": args.tip_mass, "cork": args.cork}
     settings.update({k: v for k, v in given.items() if v is not None})
     if args.mu is not None:
         settings.update(mu_s=args.mu, mu_k=args.mu)
-    for item in args.set:
-        name, sep, text = item.partition("=")
-        if not sep:
-            raise ParameterError(f"--set expects NAME=VALUE, got {item!r}")
-        settings[name.strip()] = _value(text.strip())
+    settings.update({name: _value(text) for name, text in _pairs(args.set, "--set").items()})
     drive = {}
     if args.freq_hz is not None:
         drive = {"drive": "sine", "freq_hz": args.freq_hz}
@@ -210,10 +214,9 @@ def _record_settings(args, meta: dict) -> dict:
         drive = {"drive": "free_decay", "deflection_cm": args.free_decay}
     elif args.impulse is not None:
         drive = {"drive": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
-    if drive:
-        for key in [k for k in settings if k in ("drive", "freq_hz", "f0_hz", "f1_hz", "sweep_s",
-                                                  "deflection_cm", "width_s", "t_hit_s")]:
-            del settings[key]
+    if drive:                  # a drive given here replaces the file's (its amplitude may stay)
+        for key in set(ALL_EXCITATION_KEYS) - {"force_n", "ramp_s"} | {"drive"}:
+            settings.pop(key, None)
         settings.update(drive)
     if args.force_n is not None:
         settings["force_n"] = args.force_n
@@ -224,23 +227,18 @@ def _record_settings(args, meta: dict) -> dict:
 
 def _read_record(args, path):
     from .expfiles import read
-    scale = {}
-    for item in args.strain_scale:
-        name, sep, text = item.partition("=")
-        if not sep:
-            raise ParameterError(f"--strain-scale expects CHANNEL=STRAIN_PER_VOLT, got {item!r}")
-        scale[name.strip().lower()] = float(text)
-    return read(path, strain_scale=scale)
+    scale = _pairs(args.strain_scale, "--strain-scale", "STRAIN_PER_VOLT")
+    return read(path, strain_scale={name.lower(): float(text) for name, text in scale.items()})
+
+
+def _add_joint_options(parser) -> None:
+    parser.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
+    parser.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
 
 
 def _add_record_options(parser) -> None:
-    parser.add_argument("--params", metavar="FILE.toml", help="base parameters from a TOML file")
-    parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
-                        help="set one parameter (repeatable), e.g. --set e_b_gpa=46.12")
-    parser.add_argument("--tip-mass", type=_on_off, metavar="on|off", help="the tip mass")
-    parser.add_argument("--cork", choices=sorted(CORK_MODELS), help="cork model (MODEL.md §6)")
-    parser.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
-    parser.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
+    _add_model_options(parser)
+    _add_joint_options(parser)
     _add_drive_options(parser)
     parser.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
                         help="scale factor of a strain channel recorded in V (strain per volt)")
@@ -271,12 +269,7 @@ def _cmd_estimate(args) -> int:
     from .estimate import estimate
     from .matching import setup_from
 
-    start = {}
-    for item in args.fit:
-        name, sep, text = item.partition("=")
-        if not sep:
-            raise ParameterError(f"--fit expects NAME=START, got {item!r}")
-        start[name.strip()] = float(text)
+    start = {name: float(text) for name, text in _pairs(args.fit, "--fit", "START").items()}
     base = Parameters.from_toml(args.params) if args.params else None
     pairs = []
     for path in args.files:
@@ -307,10 +300,10 @@ def _cmd_identify_tables(args) -> int:
 def _cmd_identify_decrement(args) -> int:
     from .identify import log_decrement
 
-    p = _parameters(args)
-    beam = {} if args.beam is None else dict(
-        mu=p.mu_a if args.beam == "a" else p.mu_b, length=p.l_a if args.beam == "a" else p.l_b,
-        area_moment=p.inertia_a if args.beam == "a" else p.inertia_b)
+    beam = {}
+    if args.beam is not None:
+        length, _, inertia, mu = _parameters(args).beam(args.beam)
+        beam = dict(mu=mu, length=length, area_moment=inertia)
     d = log_decrement(args.x1, args.xn, args.t1, args.tn, args.n, **beam)
     print(json.dumps({**d._asdict(), "E_gpa": d.E_gpa}))
     return 0
@@ -331,8 +324,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="simulate one run with contact (MODEL.md §7-9)")
     _add_model_options(run)
-    run.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
-    run.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
+    _add_joint_options(run)
     _add_drive_options(run, ramp_default=1.0)
     run.add_argument("--duration", type=float, default=1.0, help="simulated time (s)")
     run.add_argument("--dt", type=float, help="RK4 step (s); default from the model's fastest mode")

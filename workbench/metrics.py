@@ -61,6 +61,15 @@ def psd(t: np.ndarray, x: np.ndarray, segment_s: float = 1.0) -> tuple[np.ndarra
                  detrend="constant")
 
 
+def parabolic_vertex(a, b, c):
+    """The vertex of the parabola through (-1, a), (0, b), (1, c): its offset from 0
+    (in samples) and its height.  Scalars or arrays; a flat triple gives offset 0."""
+    a, b, c = (np.asarray(v, dtype=float) for v in (a, b, c))
+    den = a - 2.0 * b + c
+    shift = np.where(den != 0.0, 0.5 * (a - c) / np.where(den != 0.0, den, 1.0), 0.0)
+    return shift, b - 0.25 * (a - c) * shift
+
+
 def spectral_peaks(f: np.ndarray, p: np.ndarray, n: int = 3, fmin: float = 1.0,
                    fmax: float = 250.0, min_prominence: float = 0.5,
                    min_relative: float = 1e-4) -> np.ndarray:
@@ -77,13 +86,8 @@ def spectral_peaks(f: np.ndarray, p: np.ndarray, n: int = 3, fmin: float = 1.0,
     idx, props = find_peaks(logp, prominence=min_prominence,
                             height=float(logp.max()) + np.log10(min_relative))
     idx = idx[np.argsort(-props["prominences"])][:n]
-    out = []
-    for i in idx:
-        a, b, c = logp[i - 1], logp[i], logp[i + 1]
-        den = a - 2.0 * b + c
-        shift = 0.5 * (a - c) / den if den != 0.0 else 0.0
-        out.append(f[band][i] + shift * (f[1] - f[0]))
-    return np.sort(np.array(out))
+    shift, _ = parabolic_vertex(logp[idx - 1], logp[idx], logp[idx + 1])
+    return np.sort(f[band][idx] + shift * (f[1] - f[0]))
 
 
 def harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> dict[float, float]:

@@ -182,7 +182,7 @@ class Parameters:
 
     def first_frequency(self, beam: str) -> float:
         """A beam's own first clamped-free frequency (rad/s): 3.516/L^2 sqrt(EI/mu)."""
-        L, e, inertia, mu = self._beam(beam)
+        L, e, inertia, mu = self.beam(beam)
         return 3.516 / L ** 2 * math.sqrt(e * inertia / mu)
 
     def damping_beta(self, beam: str) -> float:
@@ -190,7 +190,8 @@ class Parameters:
         zeta = self.zeta_a if beam == "a" else self.zeta_b
         return 2.0 * zeta / self.first_frequency(beam)
 
-    def _beam(self, beam):
+    def beam(self, beam: str) -> tuple[float, float, float, float]:
+        """Beam "a" or "b": length (cm), E (g/(cm s^2)), area moment (cm^4), mass per length (g/cm)."""
         if beam == "a":
             return self.l_a, self.e_a, self.inertia_a, self.mu_a
         if beam == "b":

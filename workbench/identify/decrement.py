@@ -31,6 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..metrics import parabolic_vertex
 from ..params import ParameterError, check_positive
 
 #: Eq. 2's factor: E I = EI_FACTOR mu omega_n^2 L^4.
@@ -108,11 +109,8 @@ def decay_peaks(t: np.ndarray, x: np.ndarray, min_height: float = 0.0) -> tuple[
     x = np.asarray(x, dtype=float) - float(np.mean(x))
     idx, _ = find_peaks(x, height=min_height if min_height > 0 else None)
     idx = idx[(idx > 0) & (idx < len(x) - 1)]
-    a, b, c = x[idx - 1], x[idx], x[idx + 1]
-    den = a - 2.0 * b + c
-    shift = np.where(den != 0.0, 0.5 * (a - c) / np.where(den != 0.0, den, 1.0), 0.0)
-    dt = np.gradient(t)[idx]
-    return t[idx] + shift * dt, b - 0.25 * (a - c) * shift
+    shift, height = parabolic_vertex(x[idx - 1], x[idx], x[idx + 1])
+    return t[idx] + shift * np.gradient(t)[idx], height
 
 
 def decrement_from_record(t: np.ndarray, x: np.ndarray, min_height: float = 0.0,
