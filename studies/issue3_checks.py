@@ -23,8 +23,8 @@ print("10 s run", {k: s[k] for k in ("n_events", "n_impacts", "energy_balance_re
 # The kernel at the default step against the slow reference with events (tests/reference_hybrid.py)
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from reference_hybrid import HybridReference  # noqa: E402
+
+from workbench.reference import HybridReference  # noqa: E402
 from workbench.core import layout as ly  # noqa: E402
 k = simulate(p, None, 0.036, initial="paper")
 log, yend = HybridReference(p).run(0.0, 0.036, np.zeros(ly.N_STATE))

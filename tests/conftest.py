@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))   # tests/reference.py, tests/fe_reference.py
+sys.path.insert(0, str(Path(__file__).parent))   # tests/fe_reference.py
 
 from workbench.params import Parameters  # noqa: E402
 

@@ -2,13 +2,13 @@
 
 Tiers (STYLE.md): numerical properties (M symmetric positive definite,
 energy conserved, RK4's order 4), and a slow independent reference
-(tests/reference.py: jets for every derivative, numpy.linalg.solve,
+(workbench/reference/equations.py: jets for every derivative, numpy.linalg.solve,
 scipy's solve_ivp).
 """
 import numpy as np
 import pytest
 from conftest import random_state
-from reference import Reference
+from workbench.reference import Reference
 
 from workbench import model as mdl
 from workbench.core import layout as ly

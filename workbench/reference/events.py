@@ -1,11 +1,14 @@
-"""A slow NumPy/SciPy reference of the contact model with events (MODEL.md §7).
+"""The paper's method: the contact model (MODEL.md §7) by an adaptive solver with restarts.
 
-The paper's approach (seed §2.3): integrate one regime with an adaptive
-solver (here scipy's DOP853 at tight tolerances) until a terminal event,
-apply the transition, restart.  Coded independently of the kernels:
+Seed §2.3: integrate one regime with an adaptive solver (LSODA, as the
+paper did, or any other method of scipy's solve_ivp) until a terminal
+event, apply the transition, restart.  Slow, and coded independently of
+the kernels, so that the tests check the kernels against it and the
+benchmarks measure the kernels against it (benchmarks/, issue 6):
 
 * gaps and tangential coordinates are the formulas of MODEL.md §7 evaluated
-  on the jets of tests/reference.py (no hand-derived gradient or Hessian);
+  on the jets of :mod:`workbench.reference.equations` (no hand-derived
+  gradient or Hessian);
 * each regime is solved as the dense KKT system
   [[M, -B^T], [A, 0]] [q'', lambda] = [Q - h, -A' q'] by numpy.linalg.solve;
 * events are scipy's terminal events, located on the dense output.
@@ -19,12 +22,12 @@ event times by far less than the 1e-6 s the comparison allows.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from reference import N, Jet, Reference, jcos, jsin
+from .equations import N, Jet, Reference, jcos, jsin
 
 #: Contact sets (0-based points) in the order of MODEL.md §7; index = set number.
 SETS = ((), (0,), (1,), (2,), (3,), (0, 2), (0, 3), (1, 2), (1, 3))
@@ -60,14 +63,44 @@ def set_number(points):
     return SETS.index(tuple(sorted(points)))
 
 
-class HybridReference:
-    """Events and transitions of the loose joint, by solve_ivp with restarts."""
+@dataclass
+class ReferenceRun:
+    """What :meth:`HybridReference.run` returns.
 
-    def __init__(self, p, free=range(N), excitation=None, rtol=1e-11, atol=1e-13):
+    ``log`` the events (dicts: t, kind, from_regime, to_regime, point,
+    ke_lost), ``y`` the final state, ``t`` and ``samples`` (n, 18) the
+    states at the requested sample times reached, ``nfev`` the solver's
+    right-hand-side evaluations, ``regime`` the final regime.
+    """
+
+    log: list
+    y: np.ndarray
+    t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    samples: np.ndarray = field(default_factory=lambda: np.zeros((0, 2 * N)))
+    nfev: int = 0
+    regime: Regime = Regime()
+
+    def __iter__(self):                     # log, y = run(...) keeps working
+        return iter((self.log, self.y))
+
+
+class HybridReference:
+    """Events and transitions of the loose joint, by solve_ivp with restarts.
+
+    ``method`` is a solve_ivp method ("LSODA", the paper's, or "DOP853",
+    "Radau", ...) with tolerances ``rtol`` and ``atol`` (per state entry,
+    cm, rad and their rates).  ``excitation`` is F(t) (dyn) at force1.
+    The defaults are the tightest at which LSODA runs the tests' case
+    (at rtol 1e-11 it misplaces an impact so that no candidate is
+    consistent).
+    """
+
+    def __init__(self, p, free=range(N), excitation=None, rtol=1e-10, atol=1e-12,
+                 method="LSODA"):
         self.p = p
         self.model = Reference(p, free, excitation)
         self.free = self.model.free
-        self.rtol, self.atol = rtol, atol
+        self.rtol, self.atol, self.method = rtol, atol, method
         self._cache = (None, None)
 
     # ---- geometry (MODEL.md §7, the formulas as written) -------------------------
@@ -257,23 +290,48 @@ class HybridReference:
                                 to_regime=settled.number, point=ev.point + 1, ke_lost=ke_lost)
 
     # ---- the run ---------------------------------------------------------------------
-    def run(self, t0, t1, y0, reg=Regime(), max_events=100):
-        """Integrate from (t0, y0) in regime ``reg`` to t1; returns (event log, final y)."""
+    def run(self, t0, t1, y0, reg=Regime(), max_events=100, t_eval=None):
+        """Integrate from (t0, y0) in regime ``reg`` to t1 (s); returns a :class:`ReferenceRun`.
+
+        Stops after ``max_events`` events (the run's end time is then that of
+        the last event).  ``t_eval`` (increasing times in [t0, t1]) asks for
+        the states at those times.
+        """
         t, y = t0, np.array(y0, dtype=float)
         reg = self.settle(t, y, reg)
         log = []
+        want = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=float)
+        want = want[(want >= t0) & (want <= t1 + 1e-12 * max(1.0, abs(t1)))]
+        at_end = bool(want.size) and abs(want[-1] - t1) <= 1e-12 * max(1.0, abs(t1))
+        if at_end:
+            want = want[:-1]
+        times, samples, nfev = [], [], 0
+        if want.size and want[0] == t0:
+            times.append(t0)
+            samples.append(y.copy())
         while t < t1 and len(log) < max_events:
             evs = self.events(reg)
-            sol = solve_ivp(lambda tt, yy: self.solve(tt, yy, reg)[0], (t, t1), y,
-                            method="DOP853", rtol=self.rtol, atol=self.atol, events=evs,
-                            dense_output=False)
+            asked = want[want > t]
+            sol = solve_ivp(lambda tt, yy, r=reg: self.solve(tt, yy, r)[0], (t, t1), y,
+                            method=self.method, rtol=self.rtol, atol=self.atol, events=evs,
+                            t_eval=np.append(asked, t1))
+            nfev += sol.nfev
             if not sol.success:
                 raise RuntimeError(sol.message)
+            for tt, yy in zip(np.atleast_1d(sol.t), np.reshape(sol.y, (2 * N, -1)).T):
+                if tt < t1 or at_end:
+                    times.append(tt)
+                    samples.append(yy)
             if sol.status == 0:
-                return log, sol.y[:, -1]
+                return self._result(log, sol.y[:, -1], times, samples, nfev, reg)
             hits = [(te[0], k) for k, te in enumerate(sol.t_events) if len(te)]
             t, k = min(hits)
             y = sol.y_events[k][0]
             y, reg, row = self.transition(t, y, evs[k], reg)
             log.append(row)
-        return log, y
+        return self._result(log, y, times, samples, nfev, reg)
+
+    @staticmethod
+    def _result(log, y, times, samples, nfev, reg):
+        return ReferenceRun(log=log, y=np.asarray(y), t=np.array(times),
+                            samples=np.array(samples).reshape(-1, 2 * N), nfev=nfev, regime=reg)

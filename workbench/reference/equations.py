@@ -1,6 +1,8 @@
 """A slow, obviously-correct NumPy reference of the free-flight equations.
 
-Same physics as the kernels (MODEL.md §4-6), coded independently:
+Same physics as the kernels (MODEL.md §4-6), coded independently, for the
+tests (which check the kernels against it) and the benchmarks (the paper's
+method, :mod:`workbench.reference.events`):
 
 * positions are written as plain formulas of q, evaluated on *jets* that
   carry the value, the gradient d/dq (-> J and the angle rows a) and the
@@ -214,6 +216,10 @@ class Reference:
         qdd[f] = np.linalg.solve(M[np.ix_(f, f)], F[f])
         return qdd
 
+    def tip_y(self, q):
+        """Height of beam B's tip (cm), the last beam B element."""
+        return float(self.elements(q, np.zeros(N))[-1][3].v[-1])
+
     def rhs(self, t, y):
         return np.concatenate([y[N:], self.accelerations(t, y[:N], y[N:])])
 
@@ -228,3 +234,26 @@ class Reference:
                         rtol=rtol, atol=atol)
         assert sol.success, sol.message
         return sol.y.T, sol.nfev
+
+
+def shaker(ex):
+    """The shaker force F(t) (dyn) of a workbench excitation array (MODEL.md §8).
+
+    Sine F0 sin(2 pi f t) or linear chirp F0 sin(2 pi (f0 t + (f1 - f0) t^2 / 2T)),
+    times the soft start 1/2 (1 - cos(pi t / t_ramp)) before t_ramp; written
+    out again here, from the array's documented layout, not the kernel's code.
+    """
+    from ..core import layout as ly
+    kind, amp, t_ramp = int(ex[ly.X_KIND]), float(ex[ly.X_AMP]), float(ex[ly.X_RAMP])
+    if kind not in (ly.EXC_SINE, ly.EXC_CHIRP):
+        raise NotImplementedError("the reference drives only sine and chirp excitations")
+
+    def force(t):
+        if kind == ly.EXC_SINE:
+            phase = ex[ly.X_FREQ] * t
+        else:
+            f0 = ex[ly.X_F0]
+            phase = f0 * t + (ex[ly.X_F1] - f0) * t * t / (2.0 * ex[ly.X_T_SWEEP])
+        soft = 1.0 if t >= t_ramp else 0.5 * (1.0 - np.cos(np.pi * max(t, 0.0) / t_ramp))
+        return amp * soft * np.sin(2.0 * np.pi * phase)
+    return force
