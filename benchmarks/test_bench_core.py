@@ -1,7 +1,10 @@
 """Benchmarks of the model core (``make bench``); never part of pass/fail.
 
 * one right-hand-side evaluation, timed inside a jitted loop of 10 000 calls
-  (a Python call would time numba's argument unboxing, ~40 us, instead);
+  (a Python call would time numba's argument unboxing, ~40 us, instead):
+  the free-flight equations (9 DOF, joint locked) and the regime equations
+  of :func:`~workbench.core.constrained.rhs_regime` in free flight, single
+  contact and double contact, sticking and sliding;
 * a 10 s free-flight run at dt = 5e-5 s (joint locked: without contact the
   loose body would fly through the plates), 200 000 RK4 steps;
 * the issue-3 run: 10 s sine, 1.016 mm gap, 20 Hz, tip mass, cubic cork, at
@@ -12,6 +15,8 @@ import numpy as np
 import pytest
 
 from workbench import model as mdl
+from workbench.core import layout as ly
+from workbench.core.constrained import rhs_regime
 from workbench.core.dynamics import rhs
 from workbench.excitation import DEFAULT_FORCE_N, sine
 from workbench.freeflight import integrate
@@ -30,15 +35,48 @@ def _repeat_rhs(n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, e
     return status
 
 
+@nb.njit(cache=True)
+def _repeat_rhs_regime(n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
+    status = 0
+    for i in range(n):
+        y[0] += 1e-12
+        status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot)
+    return status
+
+
+def _state():
+    return np.concatenate([np.random.default_rng(0).normal(size=9) * 0.1, np.zeros(9)])
+
+
 @pytest.mark.parametrize("fixed", [(), mdl.JOINT], ids=["9dof", "locked"])
 def test_rhs_evaluation(benchmark, fixed):
     model, work = mdl.build(Parameters(), fixed=fixed), mdl.make_work()
-    y = np.concatenate([np.random.default_rng(0).normal(size=9) * 0.1, np.zeros(9)])
-    ydot = np.zeros(18)
+    y, ydot = _state(), np.zeros(18)
     ex = sine(1.0, 20.0)
     _repeat_rhs(10, y, *model, ex, *work, ydot)
     benchmark.extra_info["calls_per_round"] = N_CALLS
     status = benchmark(_repeat_rhs, N_CALLS, y, *model, ex, *work, ydot)
+    assert status == 0
+
+
+#: (contact set, stick): free flight; {1} and {1, 3} (the paper's code 13)
+REGIMES = {"free": (0, False), "single-stick": (1, True), "single-slip": (1, False),
+           "double-stick": (5, True), "double-slip": (5, False)}
+
+
+@pytest.mark.parametrize("regime", list(REGIMES))
+def test_rhs_regime_evaluation(benchmark, regime):
+    """rhs_regime: the equations, the contact rows and their 1-3 multipliers (MODEL.md §7)."""
+    model, work = mdl.build(Parameters()), mdl.make_work()
+    set_index, stick = REGIMES[regime]
+    work.rg[ly.RG_SET], work.rg[ly.RG_STICK], work.rg[ly.RG_SIGN] = set_index, float(stick), 1.0
+    y, ydot = np.zeros(ly.N_AUG), np.zeros(ly.N_AUG)
+    y[:ly.N_STATE] = _state()
+    ex = sine(1.0, 20.0)
+    _repeat_rhs_regime(10, y, *model, ex, *work, ydot)
+    rows = 0 if set_index == 0 else (2 if set_index > 4 else 1) + int(stick)
+    benchmark.extra_info.update({"calls_per_round": N_CALLS, "constraint_rows": rows})
+    status = benchmark(_repeat_rhs_regime, N_CALLS, y, *model, ex, *work, ydot)
     assert status == 0
 
 

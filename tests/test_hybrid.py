@@ -18,7 +18,9 @@ from workbench.core.constrained import kinetic_energy, rhs_regime
 from workbench.core.contact import eval_geometry
 from workbench.core.hybrid import impact
 from workbench.params import ParameterError, Parameters
-from workbench.simulate import contact_code, regime_name, simulate
+from workbench.simulate import (MAX_DEFAULT_DT, NICE_STEPS, STABILITY_MARGIN, contact_code,
+                                default_dt, regime_name, rk4_amplification, simulate)
+from workbench.modes import linear_eigenvalues
 from workbench.statics import static_equilibrium
 
 ALL = set(ly.COORD_NAMES)
@@ -154,6 +156,10 @@ def test_static_equilibrium_is_balanced_and_admissible():
         if tip:
             assert eq.contact_code == 23               # MODEL.md §8: pried into {2, 3}
         assert eq.tip_y < -1.0                         # it sags by centimetres
+        again = static_equilibrium(p)                 # solved once per process, then copied
+        assert again is not eq and np.array_equal(again.q, eq.q)
+        again.q[:] = 0.0
+        assert np.array_equal(static_equilibrium(p).q, eq.q)
         # starting there, nothing moves
         run = simulate(p, None, 0.05)
         assert run.ok and run.summary()["n_events"] == 0
@@ -172,7 +178,14 @@ def test_paper_start_run_is_consistent(paper_start_run):
     assert s["n_impacts"] > 5
     assert s["max_penetration_cm"] < 1e-8
     assert s["max_drift_cm"] < 1e-8
-    assert s["energy_balance_rel"] < 1e-3
+    # At the default step (1e-4 s with the tip mass) the account's residual is
+    # 3.5e-3 of the throughput here: nearly all of it is the integral of the
+    # structural dissipation q'^T C q' of beam B's overdamped axial mode,
+    # which RK4 keeps stable but does not resolve (5.8e2 of 1.1e5 erg; the
+    # mechanical energy itself is within 1.6 erg of a converged run, the tip
+    # within 2.4e-8 of its range).  It falls fourth-order with the step
+    # (test_energy_balance_closes_at_a_fine_step).
+    assert s["energy_balance_rel"] < 1e-2
     assert abs(sum(s["contact_time_share"].values()) - 1) < 1e-12
     # every transition is between compatible contact sets: an impact adds
     # its point (which may separate again at once, when the contact force
@@ -270,6 +283,47 @@ def test_bad_input_names_the_parameter():
         simulate(p, None, 0.1, initial="upside-down")
     with pytest.raises(ParameterError, match="free_decay_cm"):
         simulate(p, X.sine(1.0, 20.0), 0.1, free_decay_cm=1.0)
+    with pytest.raises(ParameterError, match="t0"):
+        simulate(p, None, 0.1, t0=-1.0)
+    with pytest.raises(ParameterError, match="regime = 17 .* 0..16"):
+        simulate(p, None, 0.1, initial=np.zeros(18), regime=17)
+
+
+def test_rk4_stability_boundaries_closed_form():
+    # Hairer & Wanner, Solving ODEs II, §IV.2: classical RK4 is stable on the
+    # negative real axis to -2.7853 and on the imaginary axis to 2 sqrt(2)
+    assert rk4_amplification(-2.785293563) == pytest.approx(1.0, abs=1e-8)
+    assert rk4_amplification(2j * math.sqrt(2.0)) == pytest.approx(1.0, abs=1e-12)
+    assert rk4_amplification(-2.79) > 1.0 > rk4_amplification(-2.78)
+
+
+@pytest.mark.parametrize("tip, expected", [(True, 1e-4), (False, 2e-5)])
+def test_default_step_is_the_largest_stable_nice_step(tip, expected):
+    p = Parameters(tip_mass=tip)
+    dt = default_dt(p)
+    assert dt == expected
+    lam = STABILITY_MARGIN * linear_eigenvalues(p)
+    assert rk4_amplification(lam * dt).max() <= 1.0
+    larger = [h for h in NICE_STEPS if dt < h <= MAX_DEFAULT_DT]
+    for h in larger:                                # every larger candidate is unstable
+        assert rk4_amplification(lam * h).max() > 1.0
+
+
+def test_a_run_continued_from_its_state_follows_the_whole_run():
+    p = Parameters().replace(gap_mm=1.016)
+    ex = X.sine(X.DEFAULT_FORCE_N, 20.0, ramp_s=0.2)
+    whole = simulate(p, ex, 0.6)
+    sig = whole.signals
+    k = int(np.argmin(np.abs(sig.index.to_numpy() - 0.3)))
+    cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]
+    rest = simulate(p, ex, 0.3, initial=sig[cols].iloc[k].to_numpy(), t0=float(sig.index[k]),
+                    regime=int(sig.regime.iloc[k]))
+    assert rest.ok and rest.simulated_s == pytest.approx(0.3)
+    assert rest.signals.index[0] == pytest.approx(0.3) and rest.t_end == pytest.approx(0.6)
+    later = whole.events[whole.events.t > 0.3 + 1e-9]
+    assert len(rest.events) - 1 == len(later) > 0
+    assert np.allclose(rest.events.t.iloc[1:], later.t, atol=1e-9)
+    assert np.abs(rest.signals.tip_y.to_numpy() - sig.tip_y.to_numpy()[k:]).max() < 1e-7
 
 
 def test_cli_run_json(capsys):

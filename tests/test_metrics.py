@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.metrics import harmonic_amplitudes, once_per_period, regime_time
+from workbench.metrics import contact_shares, harmonic_amplitudes, once_per_period, regime_time
 
 
 def test_harmonic_amplitudes_recover_a_known_mixture():
@@ -32,3 +32,10 @@ def test_regime_time_splits_the_window_by_the_event_log():
     spent = regime_time(events, 1.0, 2.0)
     assert spent == pytest.approx({5: 0.2, 6: 0.7, 0: 0.1})
     assert sum(spent.values()) == pytest.approx(1.0)
+
+
+def test_contact_shares_group_regimes_by_the_papers_code():
+    # regimes 9 and 10 are contact set 5 = {1, 3} sticking and sliding: code 13
+    events = pd.DataFrame({"t": [0.0, 1.0, 3.0, 3.5], "to_regime": [0, 1, 9, 10]})
+    shares = contact_shares(events, 0.0, 4.0)
+    assert shares == pytest.approx({"0": 0.25, "1": 0.5, "13": 0.25})

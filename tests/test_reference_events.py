@@ -9,7 +9,9 @@ separation.
 import numpy as np
 import pytest
 
-from workbench.reference import HybridReference
+from workbench.core.excitation import shaker_force
+from workbench.excitation import chirp, sine
+from workbench.reference import HybridReference, shaker
 from workbench.core import layout as ly
 from workbench.params import Parameters
 from workbench.simulate import simulate
@@ -56,3 +58,12 @@ def test_sampled_tip_height_agrees_with_the_reference(both):
     tip = np.array([ref.model.tip_y(y[:ly.N_DOF]) for y in run.samples])
     assert np.abs(tip - kernel.signals.tip_y.to_numpy()).max() < 1e-7
     assert run.nfev > 0
+
+
+@pytest.mark.parametrize("ex", [sine(20.0, 35.0, ramp_s=0.5), chirp(10.0, 5.0, 65.0, 240.0, ramp_s=1.0)],
+                         ids=["sine", "chirp"])
+def test_reference_drive_agrees_with_the_kernels(ex):
+    """The reference writes the shaker force out again; both read the same array."""
+    force = shaker(ex)
+    for t in (0.0, 0.13, 0.49, 0.77, 1.5, 120.25, 239.9):
+        assert force(t) == pytest.approx(shaker_force(t, ex), rel=1e-12, abs=1e-9)

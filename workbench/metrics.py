@@ -119,6 +119,19 @@ def regime_time(events, t0: float, t1: float) -> dict[int, float]:
     return out
 
 
+def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
+    """Fraction of [t0, t1] spent in each contact code ("0", "1", ..., "23"), from an event log.
+
+    ``events`` has columns t and to_regime (a run's events, or a reference's log).
+    """
+    share: dict[str, float] = {}
+    for reg, dur in regime_time(events, t0, t1).items():
+        code = str(ly.CONTACT_CODE[(reg + 1) // 2])
+        share[code] = share.get(code, 0.0) + dur
+    total = t1 - t0
+    return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}
+
+
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
                   steady_tol: float = STEADY_TOL) -> dict:
     """The metrics of the module docstring for a finished :class:`~workbench.simulate.Run`."""

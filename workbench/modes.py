@@ -61,14 +61,15 @@ def mode_shapes(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.nd
     return _to_hz(lam), vec, names
 
 
-def fastest_rate(p: Parameters) -> float:
-    """Largest |eigenvalue| (1/s) of the damped linear system, joint free or locked.
+def linear_eigenvalues(p: Parameters) -> np.ndarray:
+    """Eigenvalues (1/s) of the damped linear system, joint free and locked (concatenated).
 
-    Sets the explicit integrator's step: the stiffness-proportional damping
-    C = beta K of MODEL.md §5 makes the beams' axial modes overdamped, with
-    a fast real eigenvalue (about 9e4 1/s for beam B without the tip mass).
+    They set the explicit integrator's step (:func:`workbench.simulate.default_dt`):
+    the stiffness-proportional damping C = beta K of MODEL.md §5 makes the
+    beams' axial modes overdamped, with a fast real eigenvalue (about
+    -9.3e4 1/s for beam B without the tip mass; with it, -1.8e4 +- 1.0e4 j).
     """
-    rate = 0.0
+    out = []
     for joint in ("free", "locked"):
         M, K, names = linear_matrices(p, joint)
         model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
@@ -78,5 +79,6 @@ def fastest_rate(p: Parameters) -> float:
         n = len(names)
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-        rate = max(rate, float(np.max(np.abs(np.linalg.eigvals(A)))))
-    return rate
+        out.append(np.linalg.eigvals(A))
+    return np.concatenate(out)
+

@@ -23,32 +23,51 @@ from . import model as mdl
 from .core import layout as ly
 from .core.hybrid import run_hybrid
 from .excitation import none
-from .metrics import regime_time
+from .metrics import contact_shares
 from .params import ParameterError, Parameters, check_positive
 from .statics import static_equilibrium, tip_load_for_deflection
 
 #: Steps :func:`default_dt` chooses from (s): each divides 1 ms.
-NICE_STEPS = (5e-5, 4e-5, 2.5e-5, 2e-5, 1e-5, 5e-6)
-#: |lambda| dt bound of :func:`default_dt`: RK4 is stable to 2.78 on the
-#: negative real axis and 2.83 on the imaginary one; 2.0 leaves room for
-#: the stiffening of contact.
-STABLE_RATE_DT = 2.0
-DEFAULT_OUTPUT_HZ = 1000.0
+NICE_STEPS = (1e-4, 5e-5, 4e-5, 2.5e-5, 2e-5, 1e-5, 5e-6)
+#: :func:`default_dt` asks RK4 to be stable for every eigenvalue of the
+#: linear model scaled by this factor: room for the stiffening of contact.
+STABILITY_MARGIN = 1.25
+#: The largest default step (s): the accuracy study of issue 6 (README
+#: "Performance") finds the tip height to ~1e-7 and the contact time shares
+#: to ~1e-7 of the converged run at 1e-4 s.
+MAX_DEFAULT_DT = 1e-4
+#: Steps per hammer pulse at least (the pulse's half-sine and its ends).
+PULSE_STEPS = 20
 
 
-def default_dt(p: Parameters) -> float:
-    """The largest step of NICE_STEPS with |lambda|_max dt <= STABLE_RATE_DT.
+def rk4_amplification(z: np.ndarray) -> np.ndarray:
+    """|R(z)| of classical RK4, R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24 (z = lambda dt)."""
+    z = np.asarray(z, dtype=complex)
+    return np.abs(1.0 + z * (1.0 + z / 2.0 * (1.0 + z / 3.0 * (1.0 + z / 4.0))))
 
-    lambda_max from :func:`workbench.modes.fastest_rate`.  With the tip mass
-    this is 5e-5 s (capped there for accuracy); without it beam B's
-    overdamped axial mode needs 2e-5 s.
+
+def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
+    """The largest step of NICE_STEPS (at most MAX_DEFAULT_DT) at which RK4 is stable.
+
+    Stable: |R(STABILITY_MARGIN lambda dt)| <= 1 for every eigenvalue lambda
+    of :func:`workbench.modes.linear_eigenvalues`.  With the tip mass this
+    is 1e-4 s (beam B's axial mode, -1.8e4 +- 1.0e4 j 1/s); without it 2e-5
+    s (the same mode overdamped, -9.3e4 1/s, on the real axis where RK4
+    is stable to 2.785).  A hammer pulse gets at least PULSE_STEPS steps.
     """
-    from .modes import fastest_rate
-    rate = fastest_rate(p)
+    from .modes import linear_eigenvalues
+    lam = STABILITY_MARGIN * linear_eigenvalues(p)
+    limit = MAX_DEFAULT_DT
+    if excitation is not None and int(excitation[ly.X_KIND]) in (ly.EXC_HAMMER_JOINT,
+                                                                 ly.EXC_HAMMER_TIP):
+        limit = min(limit, excitation[ly.X_WIDTH] / PULSE_STEPS)
     for dt in NICE_STEPS:
-        if dt * rate <= STABLE_RATE_DT:
+        if dt <= limit * (1.0 + 1e-12) and np.all(rk4_amplification(lam * dt) <= 1.0):
             return dt
     return NICE_STEPS[-1]
+
+
+DEFAULT_OUTPUT_HZ = 1000.0
 _CHUNK_S = 1.0
 _LOG_ROWS = 8192
 
@@ -75,14 +94,21 @@ class Run:
     static_tip_y: float
     initial: str
     units: dict = field(default_factory=dict)
+    t0: float = 0.0
 
     @property
     def ok(self) -> bool:
         return self.status == ly.OK
 
     @property
-    def simulated_s(self) -> float:
+    def t_end(self) -> float:
+        """The time reached (s): t0 + duration unless the run stopped early."""
         return float(self.stats["t_reached"])
+
+    @property
+    def simulated_s(self) -> float:
+        """Simulated seconds: the time reached minus the start time t0."""
+        return self.t_end - self.t0
 
     @property
     def transitions(self) -> pd.DataFrame:
@@ -114,13 +140,7 @@ class Run:
 
     def contact_time_share(self) -> dict[str, float]:
         """Fraction of the simulated time spent in each contact code (from the event log)."""
-        share: dict[str, float] = {}
-        total = self.simulated_s - float(self.events.t.iloc[0])
-        for reg, dur in regime_time(self.events, float(self.events.t.iloc[0]),
-                                    self.simulated_s).items():
-            code = str(contact_code(reg))
-            share[code] = share.get(code, 0.0) + dur
-        return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}
+        return contact_shares(self.events, float(self.events.t.iloc[0]), self.t_end)
 
     def summary(self) -> dict:
         """Scalar results of the run (the ``workbench run --json`` object)."""
@@ -170,7 +190,7 @@ def regime_name(regime: int) -> str:
 
 
 def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: float | None = None,
-                  static=None):
+                  static=None, regime: int = 0):
     """The augmented initial state (N_AUG,), its regime (set, stick) and a label.
 
     ``static`` is the gravity equilibrium if already solved (it is not
@@ -178,8 +198,10 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
 
     ``initial``: "static" (equilibrium under gravity), "paper" (undeformed,
     at rest, loose body centred, free flight, seed §2.3) or an 18-vector
-    (q, q').  ``free_decay_cm`` deflects the tip statically by that much
-    first (MODEL.md §8 free decay; implies the static start).
+    (q, q') in the regime ``regime`` (0..16, default free flight; the
+    kernel settles it, MODEL.md §7).  ``free_decay_cm`` deflects the tip
+    statically by that much first (MODEL.md §8 free decay; implies the
+    static start).
     """
     y = np.zeros(ly.N_AUG)
     if free_decay_cm is not None:
@@ -199,16 +221,22 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
     if arr.shape != (ly.N_STATE,) or not np.all(np.isfinite(arr)):
         raise ParameterError(f"initial state must be {ly.N_STATE} finite values (q, q'), "
                              f"got shape {arr.shape}")
+    if not (isinstance(regime, (int, np.integer)) and 0 <= regime <= 16):
+        raise ParameterError(f"regime = {regime!r} is outside the allowed range 0..16")
     y[:ly.N_STATE] = arr
-    return y, (0, False), "given"
+    return y, ((int(regime) + 1) // 2, regime % 2 == 1), "given"
 
 
 def simulate(params: Parameters, excitation: np.ndarray | None = None, duration: float = 1.0, *,
              dt: float | None = None, output_hz: float = DEFAULT_OUTPUT_HZ, initial="static",
-             free_decay_cm: float | None = None, fixed=(), progress: bool = False) -> Run:
+             free_decay_cm: float | None = None, fixed=(), progress: bool = False,
+             t0: float = 0.0, regime: int = 0) -> Run:
     """Simulate ``duration`` seconds of the loose-joint beam (MODEL.md §3-9).
 
     ``excitation`` is an array from :mod:`workbench.excitation` (default: none).
+    ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
+    excitation is evaluated at those times (e.g. to continue from a state
+    of an earlier run, given as ``initial`` with its ``regime``).
     ``dt`` is the RK4 step (s), by default :func:`default_dt`.
     ``output_hz`` is the sample rate of the signals; 1 / (output_hz dt)
     must be a whole number.  ``fixed`` holds coordinates (tests, locked
@@ -218,7 +246,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if not isinstance(params, Parameters):
         raise ParameterError(f"params must be workbench.params.Parameters, got {type(params).__name__}")
     duration = check_positive("duration", duration, "s")
-    dt = default_dt(params) if dt is None else check_positive("dt", dt, "s")
+    t0 = check_positive("t0", t0, "s", allow_zero=True)
+    ex = none() if excitation is None else np.asarray(excitation, dtype=float)
+    if ex.shape != (ly.N_EXC,):
+        raise ParameterError("excitation must come from workbench.excitation (an array of "
+                             f"{ly.N_EXC} values)")
+    dt = default_dt(params, ex) if dt is None else check_positive("dt", dt, "s")
     if dt > 1e-3:
         raise ParameterError(f"dt = {dt} s is outside the allowed range (0, 1e-3] s "
                              "(RK4 is unstable above ~8e-5 s for these beams)")
@@ -230,10 +263,6 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     n_steps = round(duration / dt)
     if abs(n_steps * dt - duration) > 1e-9 * duration:
         raise ParameterError(f"duration = {duration} s is not a whole number of steps dt = {dt} s")
-    ex = none() if excitation is None else np.asarray(excitation, dtype=float)
-    if ex.shape != (ly.N_EXC,):
-        raise ParameterError("excitation must come from workbench.excitation (an array of "
-                             f"{ly.N_EXC} values)")
     if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
         raise ParameterError("free_decay_cm releases the structure without excitation; "
                              "leave excitation unset")
@@ -243,7 +272,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         static = static_equilibrium(params, 0.0, fixed)     # the tip's reference position
     except ParameterError:
         static = None
-    y, (set0, stick0), label = initial_state(params, initial, fixed, free_decay_cm, static)
+    y, (set0, stick0), label = initial_state(params, initial, fixed, free_decay_cm, static, regime)
     static_tip = float("nan") if static is None else static.tip_y
     work.rg[ly.RG_SET] = set0
     work.rg[ly.RG_STICK] = 1.0 if stick0 else 0.0
@@ -265,7 +294,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         out_y = np.empty((n_out, ly.N_STATE))
         out_sig = np.empty((n_out, ly.N_SIG))
         log = np.empty((_LOG_ROWS, ly.N_LOG))
-        status, stored, n_log = run_hybrid(y, done * dt, dt, n, done, decim, *model, ex, *work,
+        status, stored, n_log = run_hybrid(y, t0 + done * dt, dt, n, done, decim, *model, ex, *work,
                                            out_t, out_y, out_sig, log, st)
         parts_t.append(out_t[:stored])
         parts_y.append(out_y[:stored])
@@ -288,11 +317,11 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if bar is not None:
         bar.close()
     return _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
-                     st, static_tip, label)
+                     st, static_tip, label, t0)
 
 
 def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log, st,
-              static_tip, label) -> Run:
+              static_tip, label, t0) -> Run:
     t = np.concatenate(parts_t)
     ys = np.concatenate(parts_y)
     sig = np.concatenate(parts_s)
@@ -327,4 +356,4 @@ def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s,
              "steps": int(st[ly.ST_STEP])}
     return Run(params=params, excitation=ex, dt=dt, duration=duration, status=int(status),
                message=ly.MESSAGES[int(status)], wall_s=wall, signals=df, events=events,
-               stats=stats, static_tip_y=static_tip, initial=label, units=units)
+               stats=stats, static_tip_y=static_tip, initial=label, units=units, t0=t0)

@@ -22,6 +22,8 @@ potential energy is the equilibrium.
 """
 from __future__ import annotations
 
+import copy
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -194,6 +196,18 @@ def static_equilibrium(p: Parameters, tip_load_n: float = 0.0, fixed=(), s0: flo
         raise ParameterError(f"expected workbench.params.Parameters, got {type(p).__name__}")
     if not np.isfinite(tip_load_n):
         raise ParameterError(f"tip_load_n = {tip_load_n!r} N must be finite")
+    if q_guess is None:     # the common case (every simulate call): solved once per process
+        return copy.deepcopy(_equilibrium_from_rest(p, float(tip_load_n), tuple(fixed),
+                                                    float(s0)))
+    return _solve_equilibrium(p, tip_load_n, fixed, s0, q_guess)
+
+
+@functools.lru_cache(maxsize=256)
+def _equilibrium_from_rest(p: Parameters, tip_load_n: float, fixed: tuple, s0: float):
+    return _solve_equilibrium(p, tip_load_n, fixed, s0, None)
+
+
+def _solve_equilibrium(p, tip_load_n, fixed, s0, q_guess):
     st = _Statics(p, fixed, tip_load_n * DYN_PER_N)
     guess = np.zeros(ly.N_DOF) if q_guess is None else np.array(q_guess, dtype=float)
     guess[ly.S] = s0

@@ -11,7 +11,9 @@ the old friction and a slip phase drifted 6e-4 cm/s off the new equations.)
 This module keys the cache by a hash of all kernel sources and of
 config.py: the kernels of ``workbench.core`` are cached under
 ``__pycache__/numba-<hash>/``, so any change to any of them compiles
-everything afresh, and entries of other versions are removed.
+everything afresh, and entries of other versions are removed.  The
+environment variable ``WORKBENCH_CACHE_ROOT`` puts the ``numba-<hash>``
+folders elsewhere (a read-only install; the compile benchmark's cold start).
 """
 from __future__ import annotations
 
@@ -36,7 +38,8 @@ def source_hash() -> str:
     return h.hexdigest()[:16]
 
 
-CACHE_DIR = _CORE / "__pycache__" / (_PREFIX + source_hash())
+CACHE_ROOT = Path(os.environ.get("WORKBENCH_CACHE_ROOT") or _CORE / "__pycache__")
+CACHE_DIR = CACHE_ROOT / (_PREFIX + source_hash())
 
 
 class _KernelCacheLocator(caching.InTreeCacheLocator):
@@ -58,11 +61,10 @@ def install() -> None:
     locators = caching.CacheImpl._locator_classes
     if _KernelCacheLocator not in locators:
         locators.insert(0, _KernelCacheLocator)
-    pycache = _CORE / "__pycache__"
-    if pycache.is_dir():
-        for entry in pycache.iterdir():
+    if CACHE_ROOT.is_dir():
+        for entry in CACHE_ROOT.iterdir():
             stale = (entry.is_dir() and entry.name.startswith(_PREFIX) and entry != CACHE_DIR) \
-                or entry.suffix in (".nbi", ".nbc")
+                or (entry.suffix in (".nbi", ".nbc") and entry.parent.parent == _CORE)
             if stale:
                 if entry.is_dir():
                     shutil.rmtree(entry, ignore_errors=True)

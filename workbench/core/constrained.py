@@ -215,13 +215,8 @@ def rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
             for which in range(n_normal):
                 p = p1 if which == 0 else p2
                 p_fric += P[ly.P_MU_K] * sign * rg[ly.RG_LN + p] * rate
-    C = kc[ly.KC_C]
-    p_damp = 0.0
-    for i in range(ly.N_DOF):
-        for j in range(ly.N_DOF):
-            p_damp += qd[i] * C[i, j] * qd[j]
     ydot[ly.A_WORK] = vec[ly.VEC_AUX, ly.AUX_P_EXT]
-    ydot[ly.A_DAMP] = p_damp
+    ydot[ly.A_DAMP] = vec[ly.VEC_AUX, ly.AUX_P_DAMP]
     ydot[ly.A_CORK] = P[ly.P_CORK_C] * qd[ly.S] * qd[ly.S]
     ydot[ly.A_FRIC] = p_fric
     ydot[ly.A_CONSTR] = p_constr

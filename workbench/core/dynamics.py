@@ -106,17 +106,29 @@ def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
 
     Units dyn, dyn cm.  The frames in ``rec`` must be current; the point
     record rows are overwritten by a hammer.  Writes the excitation's power
-    (erg/s) and the shaker and hammer forces (dyn) into vec[VEC_AUX].
+    and the structural damping's dissipation q'^T C q' (erg/s) and the
+    shaker and hammer forces (dyn) into vec[VEC_AUX].
     """
     Q = vec[ly.VEC_Q]
     aux = vec[ly.VEC_AUX]
     K = kc[ly.KC_K]
     C = kc[ly.KC_C]
-    for i in range(ly.N_DOF):
-        acc = 0.0
-        for j in range(ly.N_DOF):
-            acc += K[i, j] * q[j] + C[i, j] * qd[j]
-        Q[i] -= acc
+    # K and C are block diagonal (fill_stiffness_damping): the beams' 3 x 3
+    # blocks and the loose body's springs on v and psi.
+    p_damp = 0.0
+    for i0 in (ly.W_A, ly.W_B):
+        for i in range(i0, i0 + 3):
+            elastic = 0.0
+            damping = 0.0
+            for j in range(i0, i0 + 3):
+                elastic += K[i, j] * q[j]
+                damping += C[i, j] * qd[j]
+            Q[i] -= elastic + damping
+            p_damp += qd[i] * damping
+    for i in (ly.V, ly.PSI):
+        Q[i] -= K[i, i] * q[i] + C[i, i] * qd[i]
+        p_damp += qd[i] * C[i, i] * qd[i]
+    aux[ly.AUX_P_DAMP] = p_damp
     Q[ly.S] -= cork_force(q[ly.S], qd[ly.S], P)
     # Shaker: J^T (0, F) at force1; the vertical Jacobian row of a beam A
     # point is (N1, N2) on (w_A, phi_A).

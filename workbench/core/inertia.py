@@ -87,10 +87,11 @@ def _add_point(acc, m, rot, p, i0, beam, d0, d1, d2, omega):
 
 
 @nb.njit(**JIT_INLINE)
-def _add_frame(acc, f, moving, i0, g, M, h, Q):
+def _add_frame(acc, f, u, moving, i0, g, M, h, Q):
     """Add the accumulated points of frame record ``f`` to M, h and Q_g.
 
     ``moving`` False is the ground frame (beam A): R = I, J0 = 0, a = 0.
+    ``u`` is a scratch record for the frame's rotated Jacobian rows.
     ``i0`` the first of the three local columns.  Fills the upper triangle
     of M only.  Returns the frame's gravitational energy (erg).
     """
@@ -112,9 +113,13 @@ def _add_frame(acc, f, moving, i0, g, M, h, Q):
         gx = -g * (m * si)
         gy = -g * (m * co)
         ga = -g * (-cy * si + cx * co)
+        # U's rows x and y (R^T J0) once, into the scratch record u
         for i in range(ly.N_DOF):
-            ui0 = co * f[ly.JX + i] + si * f[ly.JY + i]
-            ui1 = -si * f[ly.JX + i] + co * f[ly.JY + i]
+            u[ly.JX + i] = co * f[ly.JX + i] + si * f[ly.JY + i]
+            u[ly.JY + i] = -si * f[ly.JX + i] + co * f[ly.JY + i]
+        for i in range(ly.N_DOF):
+            ui0 = u[ly.JX + i]
+            ui1 = u[ly.JY + i]
             ui2 = f[ly.AA + i]
             if ui0 == 0.0 and ui1 == 0.0 and ui2 == 0.0:
                 continue
@@ -122,9 +127,7 @@ def _add_frame(acc, f, moving, i0, g, M, h, Q):
             vi1 = b01 * ui0 + b11 * ui1 + b12 * ui2
             vi2 = b02 * ui0 + b12 * ui1 + b22 * ui2
             for j in range(i, ly.N_DOF):
-                uj0 = co * f[ly.JX + j] + si * f[ly.JY + j]
-                uj1 = -si * f[ly.JX + j] + co * f[ly.JY + j]
-                M[i, j] += vi0 * uj0 + vi1 * uj1 + vi2 * f[ly.AA + j]
+                M[i, j] += vi0 * u[ly.JX + j] + vi1 * u[ly.JY + j] + vi2 * f[ly.AA + j]
             h[i] += ui0 * hx + ui1 * hy + ui2 * ha
             Q[i] += ui0 * gx + ui1 * gy + ui2 * ga
             # U^T F and F^T U on the local columns
@@ -172,14 +175,14 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
         w = row[ly.T_WEIGHT]
         _add_point(acc, P[ly.P_MU_A] * w, P[ly.P_RHOI_A] * w, loc, ly.W_A, True,
                    row[ly.T_DN1], row[ly.T_DN2], 0.0, 0.0)
-    v_grav = _add_frame(acc, rec[ly.REC_JOINT], False, ly.W_A, g, M, h, Q)
+    v_grav = _add_frame(acc, rec[ly.REC_JOINT], rec[ly.REC_U], False, ly.W_A, g, M, h, Q)
     # joint body: a rigid point of the joint frame
     fj = rec[ly.REC_JOINT]
     _reset(acc)
     loc[ly.RX] = P[ly.P_C3]
     loc[ly.RY] = 0.0
     _add_point(acc, P[ly.P_M3], P[ly.P_I3], loc, ly.W_A, False, 0.0, 0.0, 0.0, fj[ly.RATE])
-    v_grav += _add_frame(acc, fj, True, ly.W_A, g, M, h, Q)
+    v_grav += _add_frame(acc, fj, rec[ly.REC_U], True, ly.W_A, g, M, h, Q)
     # loose body, beam B and the tip mass: the loose-body frame
     fl = rec[ly.REC_LOOSE]
     omega = fl[ly.RATE]
@@ -195,6 +198,6 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
                    row[ly.T_DN1], row[ly.T_DN2], 0.0, omega)
     beam_point_local(tab[tip_row(P, ly.R_TIP_B)], q, qd, ly.W_B, P[ly.P_L4], rec, ly.REC_LOCAL)
     _add_point(acc, P[ly.P_M6], P[ly.P_I6], loc, ly.W_B, True, 0.0, 1.0, 0.0, omega)
-    v_grav += _add_frame(acc, fl, True, ly.W_B, g, M, h, Q)
+    v_grav += _add_frame(acc, fl, rec[ly.REC_U], True, ly.W_B, g, M, h, Q)
     return v_grav
 

@@ -151,14 +151,16 @@ REC_LOOSE = 1    # loose-body frame: origin d = (x_in + s, v), angle phi_A + psi
 REC_LOCAL = 2    # a point in a frame, before it is carried to global
 REC_POINT = 3    # the current point, global
 REC_ACC = 4      # sums over a frame's points (workbench.core.inertia)
-N_RECS = 5
+REC_U = 5        # a frame's Jacobian rows in its own axes, JX/JY columns (workbench.core.inertia)
+N_RECS = 6
 
 # --- work matrices and vectors -----------------------------------------------
 KC_K, KC_C = 0, 1                # kc (2, 9, 9): stiffness, damping
 MAT_M, MAT_CHOL = 0, 1           # mat (2, 9, 9): mass matrix, its Cholesky factor
 VEC_H, VEC_Q, VEC_RHS, VEC_AUX = 0, 1, 2, 3  # vec (4, 9): h = sum m J^T kappa, forces, Q - h,
-AUX_VGRAV, AUX_P_EXT, AUX_F_SHAKER, AUX_F_HAMMER = 0, 1, 2, 3   # and scalars of the last rhs:
-N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer forces (dyn)
+AUX_VGRAV, AUX_P_EXT, AUX_F_SHAKER, AUX_F_HAMMER, AUX_P_DAMP = 0, 1, 2, 3, 4   # and scalars of the last rhs:
+N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer forces (dyn),
+            # structural damping dissipation (erg/s)
 # stages (N_STAGES, N_AUG): k1..k4, then state buffers.  STAGE_K1 keeps k1 of
 # the current step for re-integrating partial steps; STAGE_TRY and STAGE_HI
 # hold trial states while an event is bracketed (HI: the earliest state
