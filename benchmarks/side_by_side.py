@@ -64,16 +64,23 @@ def full_run(case: Case, dt: float | None = None):
     return simulate(case.params, case.excitation, case.duration_s, dt=dt, output_hz=SAMPLE_HZ)
 
 
+#: A window must hold at least this many of the workbench's events.
+MIN_WINDOW_EVENTS = 4
+
+
 def window_start(run, case: Case) -> tuple[float, np.ndarray, int]:
-    """(t, state, regime) at the first sample at or after window_at_s with no event within 1 ms."""
+    """(t, state, regime) at the first sample at or after window_at_s with no event
+    within 1 ms and at least MIN_WINDOW_EVENTS events in the window that follows."""
     sig = run.signals
     t = sig.index.to_numpy()
     events = run.events.t.to_numpy()
     cols = [*ly.COORD_NAMES, *(c + "_dot" for c in ly.COORD_NAMES)]
     for k in np.flatnonzero(t >= case.window_at_s - 1e-12):
-        if not (np.abs(events - t[k]) < 1e-3).any():
+        inside = ((events > t[k]) & (events < t[k] + case.window_s)).sum()
+        if inside >= MIN_WINDOW_EVENTS and not (np.abs(events - t[k]) < 1e-3).any():
             return float(t[k]), sig[cols].iloc[k].to_numpy(), int(sig.regime.iloc[k])
-    raise RuntimeError(f"no sample clear of events after {case.window_at_s} s in {case.name}")
+    raise RuntimeError(f"no sample clear of events, with events after it, after "
+                       f"{case.window_at_s} s in {case.name}")
 
 
 @dataclass

@@ -4,8 +4,10 @@
 
 Prints Markdown; ``--out`` writes it to a file; ``--readme`` replaces the
 part of the README between the markers ``<!-- bench:start -->`` and
-``<!-- bench:end -->``.  Every figure is a median of the saved rounds; the
-ratios divide figures of the same JSON, measured side by side in one run.
+``<!-- bench:end -->``.  Every figure is a median of the saved rounds.  Each
+benchmark is taken from the newest saved run that has it (a partial run,
+``pytest benchmarks/test_bench_reference.py ...``, updates its tables only);
+each table names its run, and a table's ratios come from one run.
 """
 from __future__ import annotations
 
@@ -17,15 +19,23 @@ ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:start -->", "<!-- bench:end -->"
 
 
-def newest_json() -> Path:
+def saved_runs() -> list[Path]:
     files = sorted((ROOT / ".benchmarks").glob("*/*.json"))
     if not files:
         raise SystemExit("no saved benchmark run under .benchmarks/: run `make bench` first")
-    return files[-1]
+    return files
 
 
-def _by_name(data) -> dict:
-    return {b["name"]: b for b in data["benchmarks"]}
+def newest_by_name(paths: list[Path]) -> tuple[dict, dict]:
+    """{benchmark name: its newest entry} (each entry notes its file) and the newest run's header."""
+    out, header = {}, {}
+    for path in paths:                          # oldest first: newer runs override
+        data = json.loads(path.read_text())
+        header = data
+        for b in data["benchmarks"]:
+            b["source"] = path.name
+            out[b["name"]] = b
+    return out, header
 
 
 def _median(b) -> float:
@@ -118,31 +128,41 @@ def scaling_table(b) -> list[str]:
     return rows
 
 
-def summary(path: Path) -> str:
-    data = json.loads(path.read_text())
-    b = _by_name(data)
+def summary(paths: list[Path]) -> str:
+    b, data = newest_by_name(paths)
     machine = data.get("machine_info", {})
-    parts = [f"Measured by `make bench` on {data.get('datetime', '?')[:16]} "
-             f"({machine.get('cpu', {}).get('brand_raw', machine.get('processor', '?'))}, "
-             f"{machine.get('cpu', {}).get('count', '?')} cores); source `{path.relative_to(ROOT)}`.",
-             ""]
+    parts = [f"Measured by `make bench` ({machine.get('cpu', {}).get('brand_raw', '?')}, "
+             f"{machine.get('cpu', {}).get('count', '?')} cores); JSON in `.benchmarks/`.", ""]
     for title, table in (("Cost of one right-hand side", rhs_table(b)),
                          ("Whole runs against the paper's method", runs_table(b)),
                          ("Accuracy against cost (sine window)", accuracy_table(b)),
                          ("Compilation", compile_table(b)),
                          ("Scaling: the default study's grid, 2 s per point", scaling_table(b))):
         if len(table) > 2:
-            parts += [f"**{title}**", "", *table, ""]
+            parts += [f"**{title}** ({_sources(b, title)})", "", *table, ""]
     return "\n".join(parts)
+
+
+_TABLE_PREFIXES = {"Cost": ("test_rhs",), "Whole": ("test_whole_run", "test_reference_window",
+                                                    "test_accuracy_reference[1e-08]"),
+                   "Accuracy": ("test_accuracy",), "Compilation": ("test_first_run",),
+                   "Scaling": ("test_sweep_scaling",)}
+
+
+def _sources(b, title) -> str:
+    prefixes = _TABLE_PREFIXES[title.split()[0].rstrip(":")]
+    names = sorted({v["source"] for k, v in b.items() if k.startswith(prefixes)})
+    return "run " + ", ".join(f"`{n.split('_')[0]}`" for n in names)
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--json", type=Path, nargs="*", default=None,
+                    help="saved runs to read, oldest first (default: all under .benchmarks/)")
     ap.add_argument("--readme", type=Path, default=None)
     ap.add_argument("--out", type=Path, default=None)
     args = ap.parse_args(argv)
-    text = summary(args.json or newest_json())
+    text = summary(args.json or saved_runs())
     if args.out:
         args.out.write_text(text + "\n")
     if args.readme:

@@ -307,6 +307,8 @@ def test_default_step_is_the_largest_stable_nice_step(tip, expected):
     larger = [h for h in NICE_STEPS if dt < h <= MAX_DEFAULT_DT]
     for h in larger:                                # every larger candidate is unstable
         assert rk4_amplification(lam * h).max() > 1.0
+    # a 1 ms hammer pulse gets 20 steps or more
+    assert default_dt(p, X.hammer_joint(100.0, 1e-3, 0.01)) == min(expected, 5e-5)
 
 
 def test_a_run_continued_from_its_state_follows_the_whole_run():

@@ -31,7 +31,6 @@ of the tip displacement over the last two windows; ``steady`` is
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .core import layout as ly
 
@@ -103,6 +102,7 @@ def harmonic_amplitudes(t: np.ndarray, x: np.ndarray, f_hz: float) -> dict[float
 def once_per_period(t: np.ndarray, x: np.ndarray, f_hz: float) -> np.ndarray:
     """x at the times k / f_hz (k integer) inside [t[0], t[-1]], by a cubic spline."""
     k = np.arange(np.ceil(t[0] * f_hz - 1e-9), np.floor(t[-1] * f_hz + 1e-9) + 1)
+    from scipy.interpolate import CubicSpline   # here: scipy.interpolate costs 0.5 s to import
     return CubicSpline(t, x)(k / f_hz)
 
 
