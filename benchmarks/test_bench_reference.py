@@ -77,20 +77,21 @@ def test_reference_window(benchmark, whole_runs, key):
     assert window.n_events > 0
 
 
+def _accuracy(benchmark, whole_runs, converged, solve, setting, rounds, **extra):
+    """Time ``solve`` on the sine window at ``setting`` and record its errors."""
+    t0, y0, regime = whole_runs["sine"][1]
+    window = benchmark.pedantic(solve, args=(SINE, t0, y0, regime, setting), rounds=rounds,
+                                iterations=1)
+    _record(benchmark, window, converged, case=SINE.name, t0=t0, **extra)
+    assert window.n_events > 0
+
+
 @pytest.mark.parametrize("dt", KERNEL_STEPS)
 def test_accuracy_kernel(benchmark, whole_runs, converged, dt):
-    t0, y0, regime = whole_runs["sine"][1]
-    window = benchmark.pedantic(kernel_window, args=(SINE, t0, y0, regime, dt), rounds=3,
-                                iterations=1)
-    _record(benchmark, window, converged, case=SINE.name, t0=t0,
-            default=dt == default_dt(SINE.params))
-    assert window.n_events > 0
+    _accuracy(benchmark, whole_runs, converged, kernel_window, dt, 3,
+              default=dt == default_dt(SINE.params))
 
 
 @pytest.mark.parametrize("rtol", LSODA_RTOLS)
 def test_accuracy_reference(benchmark, whole_runs, converged, rtol):
-    t0, y0, regime = whole_runs["sine"][1]
-    window = benchmark.pedantic(reference_window, args=(SINE, t0, y0, regime, rtol), rounds=1,
-                                iterations=1)
-    _record(benchmark, window, converged, case=SINE.name, t0=t0)
-    assert window.n_events > 0
+    _accuracy(benchmark, whole_runs, converged, reference_window, rtol, 1)
