@@ -3,7 +3,7 @@
 The reference (:mod:`workbench.reference`: the same equations in NumPy,
 LSODA, restarts at every event) costs milliseconds per right-hand side, so
 it cannot cover the whole 10 s sine run or the 240 s chirp in a benchmark
-(the 10 s run would take about an hour).  It is run on *windows* of them:
+(the 10 s sine run would take about 45 minutes).  It is run on *windows* of them:
 a short span that starts, in free flight, from the state the workbench
 reached at that time.  The workbench's own cost is that of the whole run,
 per simulated second; the ratio compares seconds of wall time per

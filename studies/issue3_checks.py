@@ -27,7 +27,8 @@ from pathlib import Path  # noqa: E402
 from workbench.reference import HybridReference  # noqa: E402
 from workbench.core import layout as ly  # noqa: E402
 k = simulate(p, None, 0.036, initial="paper")
-log, yend = HybridReference(p).run(0.0, 0.036, np.zeros(ly.N_STATE))
+ref_run = HybridReference(p).run(0.0, 0.036, np.zeros(ly.N_STATE))
+log, yend = ref_run.log, ref_run.y
 ev = k.events[k.events.kind != "start"]
 print("reference: events", len(ev), len(log), "max |dt|", max(abs(a - b["t"]) for a, b in zip(ev.t, log)))
 cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]

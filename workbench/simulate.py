@@ -27,14 +27,15 @@ from .metrics import contact_shares
 from .params import ParameterError, Parameters, check_positive
 from .statics import static_equilibrium, tip_load_for_deflection
 
+DEFAULT_OUTPUT_HZ = 1000.0
 #: Steps :func:`default_dt` chooses from (s): each divides 1 ms.
 NICE_STEPS = (1e-4, 5e-5, 4e-5, 2.5e-5, 2e-5, 1e-5, 5e-6)
 #: :func:`default_dt` asks RK4 to be stable for every eigenvalue of the
 #: linear model scaled by this factor: room for the stiffening of contact.
 STABILITY_MARGIN = 1.25
 #: The largest default step (s): the accuracy study of issue 6 (README
-#: "Performance") finds the tip height to ~1e-7 and the contact time shares
-#: to ~1e-7 of the converged run at 1e-4 s.
+#: "Performance") finds the tip height within ~1e-6 of its range and the
+#: contact time shares within ~1e-8 of a converged run at 1e-4 s.
 MAX_DEFAULT_DT = 1e-4
 #: Steps per hammer pulse at least (the pulse's half-sine and its ends).
 PULSE_STEPS = 20
@@ -67,7 +68,6 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
     return NICE_STEPS[-1]
 
 
-DEFAULT_OUTPUT_HZ = 1000.0
 _CHUNK_S = 1.0
 _LOG_ROWS = 8192
 
@@ -254,7 +254,8 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     dt = default_dt(params, ex) if dt is None else check_positive("dt", dt, "s")
     if dt > 1e-3:
         raise ParameterError(f"dt = {dt} s is outside the allowed range (0, 1e-3] s "
-                             "(RK4 is unstable above ~8e-5 s for these beams)")
+                             "(RK4 is unstable above ~1.3e-4 s with the tip mass, "
+                             "~3e-5 s without)")
     output_hz = check_positive("output_hz", output_hz, "Hz")
     decim = round(1.0 / (output_hz * dt))
     if decim < 1 or abs(decim * dt * output_hz - 1.0) > 1e-9:

@@ -80,9 +80,6 @@ class ReferenceRun:
     nfev: int = 0
     regime: Regime = Regime()
 
-    def __iter__(self):                     # log, y = run(...) keeps working
-        return iter((self.log, self.y))
-
 
 class HybridReference:
     """Events and transitions of the loose joint, by solve_ivp with restarts.
