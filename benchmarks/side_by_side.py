@@ -2,10 +2,10 @@
 
 The reference (:mod:`workbench.reference`: the same equations in NumPy,
 LSODA, restarts at every event) costs milliseconds per right-hand side, so
-it cannot cover the whole 10 s sine run or the 240 s chirp in a benchmark
-(the 10 s sine run would take about 45 minutes).  It is run on *windows* of them:
-a short span that starts, in free flight, from the state the workbench
-reached at that time.  The workbench's own cost is that of the whole run,
+it cannot cover the whole 10 s sine run (about 45 minutes) or the 240 s
+chirp in a benchmark.  It is run on *windows* of them: a short span that
+starts from the state and regime the workbench reached at that time, clear
+of events.  The workbench's own cost is that of the whole run,
 per simulated second; the ratio compares seconds of wall time per
 simulated second.  The kernel's accuracy is measured on the same windows
 (:func:`kernel_window`), against a converged kernel run at a tiny step.
