@@ -3,7 +3,7 @@ with an error naming the file and the line, never with a traceback or wrong data
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 from workbench import expfiles as F
 
@@ -110,6 +110,7 @@ damage = st.one_of(
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(suffix=st.sampled_from([".lvm", ".txt"]), hits=st.lists(damage, min_size=1, max_size=3))
+@example(suffix=".lvm", hits=[("insert", 0.078125, ":")])     # "Samples 30:" (found by hypothesis)
 def test_randomly_damaged_files_either_read_cleanly_or_fail_clearly(tmp_path_factory, suffix, hits):
     """Any damage gives an ExperimentFileError naming the file, or a record that is
     still well formed (finite values, increasing time, Table 2 channels)."""

@@ -201,7 +201,8 @@ def read_lvm(path, strain_scale: dict | None = None) -> pd.DataFrame:
         if not rows:
             raise ExperimentFileError(path, names_line + 1, "no data rows after the column names")
         declared = _per_channel(path, seg_line, seg, "Samples", n_ch)
-        if any(d and int(float(d)) != len(rows) for d in declared):
+        if any(d and _number(path, seg_line, "Samples", d, decimal) != len(rows)
+               for d in declared):
             raise ExperimentFileError(path, seg_line, f"the segment declares {declared[0]} samples "
                                       f"but has {len(rows)} rows (truncated file?)")
         rows = np.asarray(rows, dtype=float).reshape(len(rows), -1)
@@ -209,11 +210,13 @@ def read_lvm(path, strain_scale: dict | None = None) -> pd.DataFrame:
             times.append(rows[:, 0])
             blocks.append(rows[:, 1:])
         else:
-            x0 = float(_per_channel(path, seg_line, seg, "X0", n_ch)[0] or 0.0)
+            x0 = _per_channel(path, seg_line, seg, "X0", n_ch)[0]
+            x0 = _number(path, seg_line, "X0", x0, decimal) if x0 else 0.0
             dx = _per_channel(path, seg_line, seg, "Delta_X", n_ch)[0]
             if not dx:
                 raise ExperimentFileError(path, seg_line, "X_Columns No needs Delta_X")
-            times.append(x0 + np.arange(len(rows)) * float(dx))
+            dx = _number(path, seg_line, "Delta_X", dx, decimal)
+            times.append(x0 + np.arange(len(rows)) * dx)
             blocks.append(rows)
     if channels is None:
         raise ExperimentFileError(path, len(lines), "no data segment")
