@@ -24,9 +24,10 @@ from workbench.params import Parameters
 
 PARTS = ("mass matrix, h, gravity", "applied forces", "Cholesky of M", "rhs (free flight)",
          "rhs_regime", "RK4 step")
+RHS, RHS_REGIME = 3, 4              # the indices of the whole right-hand sides in PARTS
 
 
-@nb.njit
+@nb.njit(cache=True)
 def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
     status = 0
     for i in range(n):
@@ -39,9 +40,9 @@ def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
             add_applied_forces(1e-3 * i, q, qd, P, tab, kc, ex, rec, vec)
         elif which == 2:
             status |= factor_free(free, mat)
-        elif which == 3:
+        elif which == RHS:
             status |= rhs(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
-        elif which == 4:
+        elif which == RHS_REGIME:
             status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                                  ydot)
         else:

@@ -10,38 +10,19 @@
 * the issue-3 run: 10 s sine, 1.016 mm gap, 20 Hz, tip mass, cubic cork, at
   the default step and the default force, with contact and events.
 """
-import numba as nb
 import numpy as np
 import pytest
 
 from workbench import model as mdl
 from workbench.core import layout as ly
-from workbench.core.constrained import rhs_regime
-from workbench.core.dynamics import rhs
 from workbench.excitation import DEFAULT_FORCE_N, sine
 from workbench.freeflight import integrate
 from workbench.params import Parameters
 from workbench.simulate import simulate
 
+from rhs_parts import RHS, RHS_REGIME, repeat
+
 N_CALLS = 10_000
-
-
-@nb.njit(cache=True)
-def _repeat_rhs(n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
-    status = 0
-    for i in range(n):
-        y[0] += 1e-12          # defeat hoisting of the call out of the loop
-        status |= rhs(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
-    return status
-
-
-@nb.njit(cache=True)
-def _repeat_rhs_regime(n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
-    status = 0
-    for i in range(n):
-        y[0] += 1e-12
-        status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot)
-    return status
 
 
 def _state():
@@ -53,9 +34,9 @@ def test_rhs_evaluation(benchmark, fixed):
     model, work = mdl.build(Parameters(), fixed=fixed), mdl.make_work()
     y, ydot = _state(), np.zeros(18)
     ex = sine(1.0, 20.0)
-    _repeat_rhs(10, y, *model, ex, *work, ydot)
+    repeat(RHS, 10, y, *model, ex, *work, ydot)
     benchmark.extra_info["calls_per_round"] = N_CALLS
-    status = benchmark(_repeat_rhs, N_CALLS, y, *model, ex, *work, ydot)
+    status = benchmark(repeat, RHS, N_CALLS, y, *model, ex, *work, ydot)
     assert status == 0
 
 
@@ -73,10 +54,10 @@ def test_rhs_regime_evaluation(benchmark, regime):
     y, ydot = np.zeros(ly.N_AUG), np.zeros(ly.N_AUG)
     y[:ly.N_STATE] = _state()
     ex = sine(1.0, 20.0)
-    _repeat_rhs_regime(10, y, *model, ex, *work, ydot)
+    repeat(RHS_REGIME, 10, y, *model, ex, *work, ydot)
     rows = 0 if set_index == 0 else (2 if set_index > 4 else 1) + int(stick)
     benchmark.extra_info.update({"calls_per_round": N_CALLS, "constraint_rows": rows})
-    status = benchmark(_repeat_rhs_regime, N_CALLS, y, *model, ex, *work, ydot)
+    status = benchmark(repeat, RHS_REGIME, N_CALLS, y, *model, ex, *work, ydot)
     assert status == 0
 
 

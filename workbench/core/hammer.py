@@ -9,24 +9,13 @@ import numba as nb
 import numpy as np
 
 from ..config import JIT, JIT_INLINE, JIT_PARALLEL
+from .dynamics import cork_spring
 from .layout import ERR_NAN, OK
 
 
 @nb.njit(**JIT_INLINE)
-def _spring(s, n_exp):
-    """sign(s) |s|^n, by products for the paper's n = 1, 2, 3 (a power costs ~20x)."""
-    if n_exp == 1.0:
-        return s
-    if n_exp == 2.0:
-        return s * abs(s)
-    if n_exp == 3.0:
-        return s * s * s
-    return np.sign(s) * abs(s) ** n_exp
-
-
-@nb.njit(**JIT_INLINE)
 def _accel(s, v, inv_m, n_exp, k, c):
-    return -(k * _spring(s, n_exp) + c * v) * inv_m
+    return -(cork_spring(s, n_exp, k) + c * v) * inv_m
 
 
 @nb.njit(**JIT_INLINE)
