@@ -8,7 +8,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 RESULTS := results
 
-.PHONY: help setup test bench study clean
+.PHONY: help setup test bench study stress clean
 
 help:  ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-8s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -44,6 +44,11 @@ $(RESULTS)/index.md: $(foreach s,$(STUDIES),$(RESULTS)/$(s)/report.md) $(RESULTS
 # Exit status 3: the sweep finished but some points failed; they are listed in the report.
 $(RESULTS)/%/report.md: studies/%.toml $(SOURCES) $(STAMP)
 	$(PY) -m workbench sweep $< --results $(RESULTS) || [ $$? -eq 3 ]
+
+# The paper's operating range driven hard (MODEL.md §5-§7): not part of `make study`.
+STRESS := stress stress_paper stress_chirp
+stress: $(foreach s,$(STRESS),$(RESULTS)/$(s)/report.md)  ## the stress studies: every gap, 10-55 Hz, 20-200 N, chirps (about 30 min)
+	$(PY) studies/stress_check.py $(RESULTS) $(STRESS)
 
 $(RESULTS)/modes/modes.md: $(STAMP) studies/modes.py $(SOURCES)
 	$(PY) studies/modes.py --out $(RESULTS)/modes

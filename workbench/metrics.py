@@ -177,3 +177,33 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
         x = sig[col].to_numpy()
         out[f"diss_{name}"] = float((x[-1] - x[win][0]) / cycles)
     return out
+
+
+def contact_checks(run) -> dict:
+    """The contact logic's account of a run (MODEL.md §6-§7), for sweeps and the stress study.
+
+    The run's contact statistics (accumulations, inconsistent states
+    resolved, least-violated regimes, Moreau-Jean steps, with the energy
+    each removed; the range of s), and:
+
+    ``impact_ke_gain_rel``  the largest kinetic energy an impact added,
+                            over the run's largest kinetic energy (0: none)
+    ``stop_overtravel_cm``  how far |s| went past the slot travel (cm)
+    ``stop_force_n``        the end stop's largest force k_stop * overtravel (N)
+    ``friction_limit_n``    mu_k times the largest total normal force (N):
+                            the friction the plates can put on the slide
+    """
+    from .simulate import CONTACT_STAT_KEYS
+    p = run.params
+    out = {key: run.stats[key] for key in CONTACT_STAT_KEYS}
+    e_kin = float(run.signals.e_kin.max()) if len(run.signals) else 0.0
+    impacts = run.events[run.events.kind == "impact"]
+    gain = float(max(0.0, -impacts.ke_lost.min())) if len(impacts) else 0.0
+    out["impact_ke_gain_rel"] = gain / e_kin if e_kin > 0 else gain
+    s_abs = max(abs(out["s_min_cm"]), abs(out["s_max_cm"]))
+    over = max(0.0, s_abs - p.s_travel)
+    out["stop_overtravel_cm"] = over
+    out["stop_force_n"] = p.k_stop * over / 1e5
+    normal = run.signals[[f"lambda_n{k}" for k in range(1, 5)]].sum(axis=1)
+    out["friction_limit_n"] = float(p.mu_k * normal.max() / 1e5) if len(normal) else 0.0
+    return out

@@ -38,7 +38,7 @@ Model = namedtuple("Model", "P tab kc free")
 #: Scratch of one thread of kernel calls: ``rec`` (N_RECS, N_REC) point
 #: records, ``mat`` (2, 9, 9), ``vec`` (N_VEC, 9), ``stages`` (N_STAGES,
 #: N_AUG), contact geometry ``cg`` (2 N_POINTS, N_CG), constraint work ``cw``
-#: (N_CW, 9), regime record ``rg`` (N_RG,) and event values ``ev``
+#: (N_CW, N_CW_COLS), regime record ``rg`` (N_RG,) and event values ``ev``
 #: (N_EV_ROWS, N_EV).
 Work = namedtuple("Work", "rec mat vec stages cg cw rg ev")
 
@@ -63,6 +63,8 @@ def pack(p: Parameters) -> np.ndarray:
     P[ly.P_EI_A], P[ly.P_EI_B] = p.e_a * p.inertia_a, p.e_b * p.inertia_b
     P[ly.P_EA_A], P[ly.P_EA_B] = p.e_a * p.area_a, p.e_b * p.area_b
     P[ly.P_BETA_A], P[ly.P_BETA_B] = p.damping_beta("a"), p.damping_beta("b")
+    P[ly.P_C_AX_A], P[ly.P_C_AX_B] = p.axial_damping("a"), p.axial_damping("b")
+    P[ly.P_S_TRAVEL], P[ly.P_K_STOP] = p.s_travel, p.k_stop
     P[ly.P_M3], P[ly.P_I3], P[ly.P_C3] = p.m3, p.i3, p.c3
     P[ly.P_X_IN], P[ly.P_X_LIP] = p.x_in, p.x_lip
     P[ly.P_M4], P[ly.P_I4], P[ly.P_L4], P[ly.P_C4] = p.m4, p.i4, p.l4, p.loose_cm
@@ -117,7 +119,7 @@ def make_work() -> Work:
     """Fresh scratch arrays for one thread of kernel calls."""
     return Work(rec=np.zeros((ly.N_RECS, ly.N_REC)), mat=np.zeros((2, ly.N_DOF, ly.N_DOF)),
                 vec=np.zeros((ly.N_VEC, ly.N_DOF)), stages=np.zeros((ly.N_STAGES, ly.N_AUG)),
-                cg=np.zeros((2 * ly.N_POINTS, ly.N_CG)), cw=np.zeros((ly.N_CW, ly.N_DOF)),
+                cg=np.zeros((2 * ly.N_POINTS, ly.N_CG)), cw=np.zeros((ly.N_CW, ly.N_CW_COLS)),
                 rg=np.zeros(ly.N_RG), ev=np.zeros((ly.N_EV_ROWS, ly.N_EV)))
 
 

@@ -65,9 +65,9 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
     """Eigenvalues (1/s) of the damped linear system, joint free and locked (concatenated).
 
     They set the explicit integrator's step (:func:`workbench.simulate.default_dt`):
-    the stiffness-proportional damping C = beta K of MODEL.md §5 makes the
-    beams' axial modes overdamped, with a fast real eigenvalue (about
-    -9.3e4 1/s for beam B without the tip mass; with it, -1.8e4 +- 1.0e4 j).
+    the fastest are the beams' axial modes, damped at their own zeta
+    (MODEL.md §5): -246 +- 2.05e4 j 1/s with the tip mass, -321 +- 3.54e4 j
+    without.
     """
     out = []
     for joint in ("free", "locked"):

@@ -51,11 +51,11 @@ class ParameterError(ValueError):
 
 
 def _p(default, unit, source, lo=None, hi=None, lo_open=True, hi_open=False,
-       assumption=False, doc=""):
-    """A parameter field with its metadata (unit, source, allowed range)."""
+       assumption=False, doc="", allow_inf=False):
+    """A parameter field with its metadata (unit, source, allowed range; +inf if allow_inf)."""
     return field(default=default, metadata=dict(
         unit=unit, source=source, lo=lo, hi=hi, lo_open=lo_open,
-        hi_open=hi_open, assumption=assumption, doc=doc))
+        hi_open=hi_open, assumption=assumption, doc=doc, allow_inf=allow_inf))
 
 
 @dataclass(frozen=True)
@@ -121,6 +121,13 @@ class Parameters:
                               lo_open=False, doc="override of the cork stiffness")
     cork_c: float | None = _p(None, "g/s", "from the cork model", 0.0, lo_open=False,
                               doc="override of the cork damping")
+    s_travel: float = _p(0.705, "cm", "Table 5: mean pre-load gap (0.71, 0.77, 0.635 cm)", 0.0,
+                         assumption=True, allow_inf=True,
+                         doc="slide s before the cork bottoms out in the slot, each way "
+                             "(inf: the paper's unbounded slide)")
+    k_stop: float = _p(4.52e7, "g/s^2", "Table 5: static stiffness of the compressed cork", 0.0,
+                       lo_open=False, assumption=True,
+                       doc="stiffness of the slot's end stop beyond |s| > s_travel")
     # --- extensions of the workbench (not in the paper) ---------------------
     k_v: float = _p(0.0, "g/s^2", "workbench: 0 in the paper's model", 0.0, lo_open=False,
                     doc="optional spring holding the loose body across the gap")
@@ -186,9 +193,34 @@ class Parameters:
         return 3.516 / L ** 2 * math.sqrt(e * inertia / mu)
 
     def damping_beta(self, beam: str) -> float:
-        """Stiffness-proportional damping beta = 2 zeta / omega_1 (s), MODEL.md §5."""
+        """Bending damping C_b = beta K_b: beta = 2 zeta / omega_1 (s), MODEL.md §5."""
         zeta = self.zeta_a if beam == "a" else self.zeta_b
         return 2.0 * zeta / self.first_frequency(beam)
+
+    def axial_mass(self, beam: str) -> float:
+        """Mass (g) on a beam's tip elongation u at rest: M(0)[u, u] of MODEL.md §5.
+
+        The beam's own mu L / 3 (u(x) = xi u_tip) plus every body carried
+        outboard along the axis: for beam A the joint body, the loose body,
+        beam B and the tip mass; for beam B the tip mass.
+        """
+        tip = self.m6 if self.tip_mass else 0.0
+        if beam == "a":
+            return self.mu_a * self.l_a / 3.0 + self.m3 + self.m4 + self.mu_b * self.l_b + tip
+        return self.mu_b * self.l_b / 3.0 + tip
+
+    def axial_damping(self, beam: str) -> float:
+        """Damping (g/s) on a beam's tip elongation u, MODEL.md §5 (ASSUMPTION).
+
+        c = 2 zeta sqrt(k m): the axial coordinate's own mode (stiffness
+        EA/L, mass :meth:`axial_mass`) gets the beam's bending zeta.  Its
+        frequency is the coordinate's own, sqrt(EA/L / m): with the tip mass
+        1.0 kHz (beam A) and 2.1 kHz (beam B), without it 1.1 and 4.4 kHz.
+        """
+        L, e, _, mu = self.beam(beam)
+        zeta = self.zeta_a if beam == "a" else self.zeta_b
+        k = e * (mu / self.rho) / L
+        return 2.0 * zeta * math.sqrt(k * self.axial_mass(beam))
 
     def beam(self, beam: str) -> tuple[float, float, float, float]:
         """Beam "a" or "b": length (cm), E (g/(cm s^2)), area moment (cm^4), mass per length (g/cm)."""
@@ -307,8 +339,9 @@ def _check_number(name, value, meta):
     unit = meta["unit"]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(f"{name} must be a number ({unit}), got {value!r}")
-    if math.isnan(value) or math.isinf(value):
-        raise ParameterError(f"{name} must be finite, got {value!r} ({unit})")
+    if math.isnan(value) or (math.isinf(value) and not (meta["allow_inf"] and value > 0)):
+        allowed = "finite or inf" if meta["allow_inf"] else "finite"
+        raise ParameterError(f"{name} must be {allowed}, got {value!r} ({unit})")
     lo, hi = meta["lo"], meta["hi"]
     below = lo is not None and (value <= lo if meta["lo_open"] else value < lo)
     above = hi is not None and (value >= hi if meta["hi_open"] else value > hi)

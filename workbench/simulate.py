@@ -52,9 +52,10 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
 
     Stable: |R(STABILITY_MARGIN lambda dt)| <= 1 for every eigenvalue lambda
     of :func:`workbench.modes.linear_eigenvalues`.  With the tip mass this
-    is 1e-4 s (beam B's axial mode, -1.8e4 +- 1.0e4 j 1/s); without it 2e-5
-    s (the same mode overdamped, -9.3e4 1/s, on the real axis where RK4
-    is stable to 2.785).  A hammer pulse gets at least PULSE_STEPS steps.
+    is 1e-4 s (the fastest mode, -246 +- 2.05e4 j 1/s); without it 5e-5 s
+    (-321 +- 3.54e4 j 1/s): the beams' lightly damped axial modes, near the
+    imaginary axis where RK4 is stable to |lambda dt| = 2.83.  A hammer
+    pulse gets at least PULSE_STEPS steps.
     """
     from .modes import linear_eigenvalues
     lam = STABILITY_MARGIN * linear_eigenvalues(p)
@@ -67,6 +68,11 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
             return dt
     return NICE_STEPS[-1]
 
+
+#: Run statistics of the contact logic reported by :meth:`Run.summary` (MODEL.md §7).
+CONTACT_STAT_KEYS = ("accumulations", "accumulation_energy_lost_erg", "inconsistent_resolved",
+                     "inconsistent_energy_lost_erg", "least_violated", "stepped_steps",
+                     "stepped_energy_lost_erg", "s_min_cm", "s_max_cm")
 
 _CHUNK_S = 1.0
 _LOG_ROWS = 8192
@@ -163,6 +169,7 @@ class Run:
             "max_drift_cm": float(self.stats["max_drift_cm"]),
             "energy_balance_rel": self.energy_balance_rel(),
             "impact_energy_lost_erg": float(self.stats["impact_energy_lost_erg"]),
+            **{key: self.stats[key] for key in CONTACT_STAT_KEYS},
             "strain1_rms": float(np.std(sig.strain1)),
             "strain2_rms": float(np.std(sig.strain2)),
             "tip_disp_peak_cm": float(np.abs(tip).max()),
@@ -354,7 +361,15 @@ def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s,
     units.update({"t": "s", "impulse_t": "dyn s", "ke_lost": "erg"})
     stats = {"max_penetration_cm": max(0.0, st[ly.ST_MAX_PEN]), "max_drift_cm": st[ly.ST_MAX_DRIFT],
              "impact_energy_lost_erg": st[ly.ST_E_IMPACT], "t_reached": st[ly.ST_T],
-             "steps": int(st[ly.ST_STEP])}
+             "steps": int(st[ly.ST_STEP]),
+             "accumulations": int(st[ly.ST_N_ACCUM]),
+             "accumulation_energy_lost_erg": st[ly.ST_E_ACCUM],
+             "inconsistent_resolved": int(st[ly.ST_N_INCONSISTENT]),
+             "inconsistent_energy_lost_erg": st[ly.ST_E_INCONSISTENT],
+             "least_violated": int(st[ly.ST_N_UNRESOLVED]),
+             "stepped_steps": int(st[ly.ST_N_STEPPED]),
+             "stepped_energy_lost_erg": st[ly.ST_E_STEPPED],
+             "s_min_cm": st[ly.ST_S_MIN], "s_max_cm": st[ly.ST_S_MAX]}
     return Run(params=params, excitation=ex, dt=dt, duration=duration, status=int(status),
                message=ly.MESSAGES[int(status)], wall_s=wall, signals=df, events=events,
                stats=stats, static_tip_y=static_tip, initial=label, units=units, t0=t0)

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from .core import layout as ly
-from .metrics import point_metrics
+from .metrics import contact_checks, point_metrics
 from .provenance import code_version
 from .simulate import default_dt, simulate
 from .study import Point, Study
@@ -74,8 +74,11 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
     if run is not None:
         row["simulated_s"] = run.simulated_s
         row["n_events"] = int((run.events.kind != "start").sum())
+        row["n_impacts"] = int((run.events.kind == "impact").sum())
         row["max_penetration_cm"] = float(run.stats["max_penetration_cm"])
+        row["max_drift_cm"] = float(run.stats["max_drift_cm"])
         row["energy_balance_rel"] = run.energy_balance_rel()
+        row.update(contact_checks(run))
         row["static_tip_y"] = run.static_tip_y
         final = run.signals.iloc[-1]
         for i, c in enumerate(STATE_COLUMNS):

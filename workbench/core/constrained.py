@@ -23,10 +23,10 @@ accelerations a0 = M^-1 (Q - h):
 
     q'' = a0 + X lambda,   X = M^-1 B^T,   (A X) lambda = -A' q' - A a0.
 
-The same rows give the momentum transfer of an impact (MODEL.md §7):
-q'+ = q'- + X P with (A X) P = -A q'-.  The dense systems are at most 3x3
-and solved in place in the work array ``cw`` (layout ``CW_*``); a row that
-vanishes on the free coordinates (a held coordinate) gets lambda = 0.
+The dense systems are at most 3x3 and solved in place in the work array
+``cw`` (layout ``CW_*``); a row that vanishes on the free coordinates (a
+held coordinate) gets lambda = 0.  Impacts and the choice of the regime
+are in :mod:`workbench.core.transitions`.
 
 Drift of the active constraints is removed by :func:`project`: a
 least-squares Newton projection of (s, v, psi) onto the active gaps and of
@@ -55,43 +55,41 @@ def _put_row(cw, r, cg, geometry_row, friction_row, friction):
 
 
 @nb.njit(**JIT_INLINE)
-def set_rows(set_index, stick, sign, tpt, P, cg, cw):
+def set_rows(set_index, stick, sign, P, cg, cw):
     """Rows A and force directions B (9-vectors) of a regime into cw; return their number.
 
     Row order: the normal rows of the set's first and second point, then,
-    when sticking, the tangential row of the point ``tangent_point(set_index, tpt)``.
+    when sticking, the tangential row of the set's first point.  Slipping,
+    each point's force direction is W_n,k - mu_k sigma W_t,k with its own
+    tangential row (MODEL.md §7).
     """
     m = 0
     friction = 0.0 if stick else -P[ly.P_MU_K] * sign
-    tangent = ly.CG_T + tangent_point(set_index, tpt)
     for which in range(2):
         p = ly.SET_FIRST[set_index] if which == 0 else ly.SET_SECOND[set_index]
         if p >= 0:
-            _put_row(cw, m, cg, ly.CG_G + p, tangent, friction)
+            _put_row(cw, m, cg, ly.CG_G + p, ly.CG_T + p, friction)
             m += 1
     if stick:
+        tangent = ly.CG_T + tangent_point(set_index)
         _put_row(cw, m, cg, tangent, tangent, 0.0)
         m += 1
     return m
 
 
 @nb.njit(**JIT_INLINE)
-def tangent_point(set_index, tpt):
-    """The point whose tangential row a sticking regime holds.
+def tangent_point(set_index):
+    """The point whose tangential row a sticking regime holds: the set's first (MODEL.md §7).
 
-    The set's first point (MODEL.md §7), or its second when ``tpt`` is 1: a
-    sticking double contact locks the joint whichever row is used, but the
-    split of the contact forces depends on it.  :func:`settle` moves the row
-    to the point that stays before it lets the other separate, so that the
-    separation is consistent (the released gap then opens, by the Schur
-    complement of the symmetric sticking system).
+    In a double contact both normal rows and this row span the three joint
+    coordinates, so the joint is locked; how the contact force splits
+    between the points is then one free parameter (:func:`stick_margin`).
     """
-    p2 = ly.SET_SECOND[set_index]
-    return p2 if (tpt == 1 and p2 >= 0) else ly.SET_FIRST[set_index]
+    return ly.SET_FIRST[set_index]
 
 
 @nb.njit(**JIT_INLINE)
-def row_geometry_index(set_index, stick, tpt, r):
+def row_geometry_index(set_index, stick, r):
     """The geometry row (CG_G + k or CG_T + k) behind constraint row r of a regime."""
     p1 = ly.SET_FIRST[set_index]
     p2 = ly.SET_SECOND[set_index]
@@ -99,7 +97,7 @@ def row_geometry_index(set_index, stick, tpt, r):
         return ly.CG_G + p1
     if r == 1 and p2 >= 0:
         return ly.CG_G + p2
-    return ly.CG_T + tangent_point(set_index, tpt)
+    return ly.CG_T + tangent_point(set_index)
 
 
 @nb.njit(**JIT_INLINE)
@@ -174,24 +172,38 @@ def rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
     status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
     if status != ly.OK:
         return status
+    rg[ly.RG_VGRAV] = vec[ly.VEC_AUX, ly.AUX_VGRAV]
+    ydot[ly.A_WORK] = vec[ly.VEC_AUX, ly.AUX_P_EXT]
+    ydot[ly.A_DAMP] = vec[ly.VEC_AUX, ly.AUX_P_DAMP]
+    ydot[ly.A_CORK] = P[ly.P_CORK_C] * y[ly.N_DOF + ly.S] * y[ly.N_DOF + ly.S]
+    add_contact_forces(y, P, free, mat, cg, cw, rg, ydot)
+    return ly.OK
+
+
+@nb.njit(**JIT)
+def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
+    """Add the regime's contact forces to the free accelerations in ydot.
+
+    ydot[N_DOF:N_STATE] holds M^-1 (Q - h) on entry (M's factor current)
+    and q'' of the regime of ``rg`` on return; lambda (dyn) into rg, the
+    friction and constraint powers into ydot[A_FRIC], ydot[A_CONSTR].
+    """
     qd = y[ly.N_DOF:ly.N_STATE]
     qdd = ydot[ly.N_DOF:ly.N_STATE]
     for k in range(ly.N_POINTS):
         rg[ly.RG_LN + k] = 0.0
     rg[ly.RG_LT] = 0.0
-    rg[ly.RG_VGRAV] = vec[ly.VEC_AUX, ly.AUX_VGRAV]
     p_constr = 0.0
     p_fric = 0.0
     set_index = int(rg[ly.RG_SET])
     if set_index > 0:
         stick = rg[ly.RG_STICK] != 0.0
         sign = rg[ly.RG_SIGN]
-        tpt = int(rg[ly.RG_TPT])
         fill_geometry(y, P, cg)
-        m = set_rows(set_index, stick, sign, tpt, P, cg, cw)
+        m = set_rows(set_index, stick, sign, P, cg, cw)
         fill_delassus(free, mat, cw, m)
         for r in range(m):
-            conv = row_convective(cg, row_geometry_index(set_index, stick, tpt, r), qd)
+            conv = row_convective(cg, row_geometry_index(set_index, stick, r), qd)
             cw[ly.CW_D + r, ly.CW_C_COL] = -conv - _dot9(cw[ly.CW_A + r], qdd)
         small_solve(cw, m)
         for r in range(m):
@@ -210,26 +222,85 @@ def rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
         if stick:
             rg[ly.RG_LT] = cw[ly.CW_D + n_normal, ly.CW_L_COL]
         else:
-            # friction force -mu_k sigma lambda_n W_t: dissipates mu_k sigma lambda_n tau'
-            rate = row_rate(cg, ly.CG_T + tangent_point(set_index, tpt), qd)
+            # friction force -mu_k sigma lambda_n,k W_t,k: dissipates mu_k sigma lambda_n,k tau_k'
             for which in range(n_normal):
                 p = p1 if which == 0 else p2
-                p_fric += P[ly.P_MU_K] * sign * rg[ly.RG_LN + p] * rate
-    ydot[ly.A_WORK] = vec[ly.VEC_AUX, ly.AUX_P_EXT]
-    ydot[ly.A_DAMP] = vec[ly.VEC_AUX, ly.AUX_P_DAMP]
-    ydot[ly.A_CORK] = P[ly.P_CORK_C] * qd[ly.S] * qd[ly.S]
+                p_fric += (P[ly.P_MU_K] * sign * rg[ly.RG_LN + p]
+                           * row_rate(cg, ly.CG_T + p, qd))
     ydot[ly.A_FRIC] = p_fric
     ydot[ly.A_CONSTR] = p_constr
-    return ly.OK
 
 
 @nb.njit(**JIT_INLINE)
-def stick_margin(P, rg):
-    """mu_s sum lambda_n - |lambda_t| (dyn): >= 0 while sticking holds."""
-    total = 0.0
-    for k in range(ly.N_POINTS):
-        total += rg[ly.RG_LN + k]
-    return P[ly.P_MU_S] * total - abs(rg[ly.RG_LT])
+def _det3(a, b, c):
+    return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
+
+
+@nb.njit(**JIT_INLINE)
+def _bound(c, d, lo, hi, short):
+    """Intersect [lo, hi] with {alpha: c + d alpha >= 0}.
+
+    A condition that does not depend on alpha (d = 0) and fails lowers
+    ``short`` to c.  Returns (lo, hi, short).
+    """
+    if d == 0.0:
+        return lo, hi, min(short, c)
+    x = -c / d
+    if d > 0.0:
+        return max(lo, x), hi, short
+    return lo, min(hi, x), short
+
+
+@nb.njit(**JIT)
+def stick_margin(P, cg, rg):
+    """How far a sticking regime is inside the friction cone (dyn): >= 0 while sticking holds.
+
+    One point: mu_s lambda_n - |lambda_t|.  Two points (the forces in rg
+    solved with the first point's tangential row, cg current): the contact
+    force in (s, v, psi) splits into per-point normal and tangential forces
+    along the null direction d of the four rows (n1, t1, n2, t2), scaled to
+    unit largest entry; sticking holds while some split alpha has
+    lambda_n,k >= 0 and |lambda_t,k| <= mu_s lambda_n,k at both points.  The
+    margin is the width of that interval of alpha (dyn), so that it reaches
+    0 where the per-point slip of MODEL.md §7 takes over.
+    """
+    set_index = int(rg[ly.RG_SET])
+    p1 = ly.SET_FIRST[set_index]
+    p2 = ly.SET_SECOND[set_index]
+    mu = P[ly.P_MU_S]
+    if p2 < 0:
+        return mu * rg[ly.RG_LN + p1] - abs(rg[ly.RG_LT])
+    n1 = (cg[ly.CG_G + p1, ly.CG_DS], cg[ly.CG_G + p1, ly.CG_DV], cg[ly.CG_G + p1, ly.CG_DPSI])
+    t1 = (cg[ly.CG_T + p1, ly.CG_DS], cg[ly.CG_T + p1, ly.CG_DV], cg[ly.CG_T + p1, ly.CG_DPSI])
+    n2 = (cg[ly.CG_G + p2, ly.CG_DS], cg[ly.CG_G + p2, ly.CG_DV], cg[ly.CG_G + p2, ly.CG_DPSI])
+    t2 = (cg[ly.CG_T + p2, ly.CG_DS], cg[ly.CG_T + p2, ly.CG_DV], cg[ly.CG_T + p2, ly.CG_DPSI])
+    # null vector of the 3 x 4 matrix [n1 t1 n2 t2] by cofactors
+    d0 = _det3(t1, n2, t2)
+    d1 = -_det3(n1, n2, t2)
+    d2 = _det3(n1, t1, t2)
+    d3 = -_det3(n1, t1, n2)
+    big = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)))
+    if big > 0.0:
+        d0 /= big
+        d1 /= big
+        d2 /= big
+        d3 /= big
+    a1 = rg[ly.RG_LN + p1]
+    b1 = rg[ly.RG_LT]
+    a2 = rg[ly.RG_LN + p2]
+    lo = -1e300
+    hi = 1e300
+    short = 0.0
+    lo, hi, short = _bound(a1, d0, lo, hi, short)
+    lo, hi, short = _bound(mu * a1 - b1, mu * d0 - d1, lo, hi, short)
+    lo, hi, short = _bound(mu * a1 + b1, mu * d0 + d1, lo, hi, short)
+    lo, hi, short = _bound(a2, d2, lo, hi, short)
+    lo, hi, short = _bound(mu * a2, mu * d2 - d3, lo, hi, short)
+    lo, hi, short = _bound(mu * a2, mu * d2 + d3, lo, hi, short)
+    if short < 0.0:
+        return short
+    return min(hi - lo, 1e300)
 
 
 @nb.njit(**JIT_INLINE)
@@ -250,7 +321,7 @@ def _free_mask(free, i):
 
 
 @nb.njit(**JIT_INLINE)
-def _project_rows(y, offset, set_index, stick, tpt, rows, P, free, cg, cw):
+def _project_rows(y, offset, set_index, stick, rows, P, free, cg, cw):
     """One least-squares correction of y[offset + (S, V, PSI)] by the given rows.
 
     ``rows`` counts the rows used: the normal rows (1 or 2), plus 1 for the
@@ -263,7 +334,7 @@ def _project_rows(y, offset, set_index, stick, tpt, rows, P, free, cg, cw):
     qd = y[ly.N_DOF:ly.N_STATE]
     worst = 0.0
     for r in range(rows):
-        g = row_geometry_index(set_index, stick, tpt, r)
+        g = row_geometry_index(set_index, stick, r)
         a = cw[ly.CW_A + r]
         for j in range(ly.N_DOF):
             a[j] = 0.0
@@ -302,37 +373,14 @@ def project(y, P, free, cg, cw, rg):
     n_normal = 1 if ly.SET_SECOND[set_index] < 0 else 2
     fill_geometry(y, P, cg)
     stick = rg[ly.RG_STICK] != 0.0
-    tpt = int(rg[ly.RG_TPT])
-    drift = _project_rows(y, 0, set_index, stick, tpt, n_normal, P, free, cg, cw)
+    drift = _project_rows(y, 0, set_index, stick, n_normal, P, free, cg, cw)
     if drift > 0.0:
         fill_geometry(y, P, cg)
-        if _project_rows(y, 0, set_index, stick, tpt, n_normal, P, free, cg, cw) > 0.0:
+        if _project_rows(y, 0, set_index, stick, n_normal, P, free, cg, cw) > 0.0:
             fill_geometry(y, P, cg)
     rows = n_normal + (1 if stick else 0)
-    _project_rows(y, ly.N_DOF, set_index, stick, tpt, rows, P, free, cg, cw)
+    _project_rows(y, ly.N_DOF, set_index, stick, rows, P, free, cg, cw)
     return drift
-
-
-@nb.njit(**JIT)
-def apply_impulse(set_index, stick, sign, tpt, qd_minus, qd_plus, P, free, mat, cg, cw):
-    """Momentum transfer into a candidate regime: q'+ = q'- + M^-1 B^T P.
-
-    (A M^-1 B^T) P = -A q'-, MODEL.md §7.  Geometry and M's factor must be
-    current.  The impulses (dyn s) are left in cw[CW_D + r, CW_L_COL] in the
-    row order of :func:`set_rows`; returns the number of rows.
-    """
-    m = set_rows(set_index, stick, sign, tpt, P, cg, cw)
-    fill_delassus(free, mat, cw, m)
-    for r in range(m):
-        cw[ly.CW_D + r, ly.CW_C_COL] = -_dot9(cw[ly.CW_A + r], qd_minus)
-    small_solve(cw, m)
-    for j in range(ly.N_DOF):
-        qd_plus[j] = qd_minus[j]
-    for r in range(m):
-        imp = cw[ly.CW_D + r, ly.CW_L_COL]
-        for j in range(ly.N_DOF):
-            qd_plus[j] += cw[ly.CW_X + r, j] * imp
-    return m
 
 
 @nb.njit(**JIT_INLINE)
@@ -344,52 +392,3 @@ def kinetic_energy(qd, mat):
         for j in range(ly.N_DOF):
             acc += qd[i] * M[i, j] * qd[j]
     return 0.5 * acc
-
-
-@nb.njit(**JIT)
-def settle(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
-    """Choose the consistent regime at y without a velocity jump (MODEL.md §7).
-
-    Starts from the regime in rg.  Drops the point with the most negative
-    lambda_n (separation; a sticking double contact first moves its
-    tangential row to the staying point, see :func:`tangent_point`); turns stick into slip with sigma = -sign(lambda_t)
-    when |lambda_t| > mu_s sum lambda_n; a slipping set takes the sign of
-    its slip velocity unless that is below RATE_EPS.  Projects y onto the
-    chosen regime and leaves its rhs in ydot.  Returns a status code.
-    """
-    for _ in range(12):
-        set_index = int(rg[ly.RG_SET])
-        if set_index > 0 and rg[ly.RG_STICK] == 0.0:
-            fill_geometry(y, P, cg)
-            rate = row_rate(cg, ly.CG_T + tangent_point(set_index, int(rg[ly.RG_TPT])),
-                            y[ly.N_DOF:ly.N_STATE])
-            if abs(rate) > RATE_EPS:
-                rg[ly.RG_SIGN] = 1.0 if rate > 0.0 else -1.0
-        project(y, P, free, cg, cw, rg)
-        status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot)
-        if status != ly.OK:
-            return status
-        if set_index == 0:
-            return ly.OK
-        p1 = ly.SET_FIRST[set_index]
-        p2 = ly.SET_SECOND[set_index]
-        worst = -1
-        worst_val = -LAMBDA_EPS
-        for p in (p1, p2):
-            if p >= 0 and rg[ly.RG_LN + p] < worst_val:
-                worst = p
-                worst_val = rg[ly.RG_LN + p]
-        if worst >= 0:
-            keep = p2 if worst == p1 else p1
-            if keep >= 0 and tangent_point(set_index, int(rg[ly.RG_TPT])) == worst:
-                rg[ly.RG_TPT] = 1.0 if keep == p2 else 0.0   # hold the staying point's row
-                continue
-            rg[ly.RG_SET] = 0.0 if keep < 0 else float(keep + 1)   # set {keep + 1}
-            rg[ly.RG_TPT] = 0.0
-            continue
-        if rg[ly.RG_STICK] != 0.0 and stick_margin(P, rg) < -0.5 * stick_tolerance(P, rg):
-            rg[ly.RG_STICK] = 0.0
-            rg[ly.RG_SIGN] = -1.0 if rg[ly.RG_LT] > 0.0 else 1.0
-            continue
-        return ly.OK
-    return ly.ERR_NO_REGIME

@@ -28,25 +28,29 @@ def fill_stiffness_damping(P, kc):
     """Linear stiffness kc[KC_K] and damping kc[KC_C] (9, 9), MODEL.md §5.
 
     Per beam: bending EI/L^3 [[12, -6L], [-6L, 4L^2]] on (w, phi) and axial
-    EA/L on u (exact for the Hermite shapes); damping C = beta K per beam.
-    The optional springs k_v, k_psi on the loose body (0 in the paper's
-    model) are undamped.
+    EA/L on u (exact for the Hermite shapes); damping C_b = beta K_b on the
+    bending block and the axial coordinate's own damping c_ax on u
+    (:meth:`workbench.params.Parameters.axial_damping`).  The optional
+    springs k_v, k_psi on the loose body (0 in the paper's model) are
+    undamped.
     """
     K = kc[ly.KC_K]
     C = kc[ly.KC_C]
     K[:, :] = 0.0
     C[:, :] = 0.0
-    for i0, L, EI, EA, beta in ((ly.W_A, P[ly.P_L_A], P[ly.P_EI_A], P[ly.P_EA_A], P[ly.P_BETA_A]),
-                                (ly.W_B, P[ly.P_L_B], P[ly.P_EI_B], P[ly.P_EA_B], P[ly.P_BETA_B])):
+    for i0, L, EI, EA, beta, c_ax in (
+            (ly.W_A, P[ly.P_L_A], P[ly.P_EI_A], P[ly.P_EA_A], P[ly.P_BETA_A], P[ly.P_C_AX_A]),
+            (ly.W_B, P[ly.P_L_B], P[ly.P_EI_B], P[ly.P_EA_B], P[ly.P_BETA_B], P[ly.P_C_AX_B])):
         kb = EI / L ** 3
         K[i0, i0] = 12.0 * kb
         K[i0, i0 + 1] = -6.0 * L * kb
         K[i0 + 1, i0] = -6.0 * L * kb
         K[i0 + 1, i0 + 1] = 4.0 * L * L * kb
         K[i0 + 2, i0 + 2] = EA / L
-        for i in range(i0, i0 + 3):
-            for j in range(i0, i0 + 3):
+        for i in range(i0, i0 + 2):
+            for j in range(i0, i0 + 2):
                 C[i, j] = beta * K[i, j]
+        C[i0 + 2, i0 + 2] = c_ax
     K[ly.V, ly.V] = P[ly.P_K_V]
     K[ly.PSI, ly.PSI] = P[ly.P_K_PSI]
 
@@ -66,16 +70,28 @@ def cork_spring(s, n, k):
 
 
 @nb.njit(**JIT_INLINE)
+def slot_overtravel(s, P):
+    """How far the slide s is past the slot's end stop (cm): |s| - s_travel, or 0."""
+    return max(abs(s) - P[ly.P_S_TRAVEL], 0.0)
+
+
+@nb.njit(**JIT_INLINE)
 def cork_force(s, sd, P):
-    """Cork force on the slide s (dyn), MODEL.md §6: k sign(s)|s|^n + c s'."""
-    return cork_spring(s, P[ly.P_CORK_N], P[ly.P_CORK_K]) + P[ly.P_CORK_C] * sd
+    """Cork force on the slide s (dyn), MODEL.md §6.
+
+    k sign(s)|s|^n + c s', plus the slot's end stop k_stop (|s| - s_travel)
+    sign(s) beyond |s| > s_travel.
+    """
+    stop = P[ly.P_K_STOP] * math.copysign(slot_overtravel(s, P), s)
+    return cork_spring(s, P[ly.P_CORK_N], P[ly.P_CORK_K]) + stop + P[ly.P_CORK_C] * sd
 
 
 @nb.njit(**JIT_INLINE)
 def cork_energy(s, P):
-    """Cork potential k |s|^(n+1) / (n+1) (erg), MODEL.md §6."""
+    """Cork potential k |s|^(n+1) / (n+1) + k_stop (|s| - s_travel)_+^2 / 2 (erg), MODEL.md §6."""
     n = P[ly.P_CORK_N]
-    return P[ly.P_CORK_K] * abs(s) ** (n + 1.0) / (n + 1.0)
+    over = slot_overtravel(s, P)
+    return P[ly.P_CORK_K] * abs(s) ** (n + 1.0) / (n + 1.0) + 0.5 * P[ly.P_K_STOP] * over * over
 
 
 @nb.njit(**JIT_INLINE)

@@ -4,7 +4,9 @@ Fixed RK4 steps in the current regime; after each step the events of the
 regime are evaluated (every event function goes from + to - when its event
 happens, layout ``EV_*``):
 
-    open gap g_k + GAP_EPS                  impact of point k
+    open gap g_k + arm_k                    impact of point k (arm_k: GAP_EPS, or
+                                            the depth at which a released point
+                                            left, rg[RG_ARM + k])
     lambda_n,k + LAMBDA_EPS, active k       separation of point k (or, in a sticking
                                             double contact, the move of its
                                             tangential row to the other point)
@@ -19,27 +21,40 @@ step, whose minimum is then checked by re-integration.  Several events in a
 step are taken in time order: the earliest is applied, and the rest of the
 step is integrated again in the new regime.
 
-Impacts are momentum transfers (:func:`impact`): the candidate regimes,
-double contacts first, sticking before sliding, are tried in order and the
-first consistent one is taken.  Each event is written to the log (layout
-``LOG_*``); failures end the run with a status code, keeping the samples
-and the log written so far.
+Transitions (:mod:`workbench.core.transitions`): an impact is a momentum
+transfer by Moreau's impact law over every closed or closing point; after
+every event the new regime is chosen by the acceleration-level
+enumeration.  Impacts that recur within ACCUM_STEPS steps, or close slower
+than the gap's free acceleration makes in ACCUM_STEPS steps, are an
+accumulation: the impact set then takes every point within ACCUM_GAP_TOL,
+so the micro-collisions end in the persistent contact.  A watched gap
+that is already closed is an impact only while it approaches faster than
+CLOSED_RATE.  More than MAX_EVENTS_PER_STEP events in one step hand the
+rest of the step and STEPPED_STEPS more to Moreau-Jean time-stepping
+(:func:`workbench.core.transitions.moreau_jean_step`).  Each event is
+written to the log (layout ``LOG_*``); failures (NaN, a mass matrix that
+is not positive definite) end the run with a status code, keeping the
+samples and the log written so far.
 """
 import numba as nb
 
-from ..config import (EVENT_TIME_TOL, GAP_EPS, JIT, JIT_INLINE, LAMBDA_EPS,
+from ..config import (EVENT_TIME_TOL, JIT, JIT_INLINE, LAMBDA_EPS,
                       MAX_EVENTS_PER_STEP, RATE_EPS)
 from . import layout as ly
-from .constrained import (apply_impulse, kinetic_energy, project, rhs_regime, settle,
-                          stick_margin, stick_tolerance, tangent_point)
-from .contact import fill_geometry, in_set, regime_of, row_rate
+from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
+from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
+from .dynamics import rhs
 from .integrate import rk4_step
 from .sensors import fill_signals
+from .transitions import (ACCUM_GAP_TOL, CLOSED_RATE, GAP_TOL, choose_regime, impact,
+                          moreau_jean_step)
 
-#: Candidate contact sets of an impact, double contacts first.
-_IMPACT_ORDER = (5, 6, 7, 8, 1, 2, 3, 4)
-#: A point whose gap is below this (cm) at an impact may take part in it.
-_CLOSED_GAP = 1e-9
+#: Impacts recurring within this many steps, or closing slower than the gap's
+#: free acceleration makes in this many steps, are an accumulation (MODEL.md §7).
+ACCUM_STEPS = 3.0
+#: Steps of Moreau-Jean time-stepping after an event flood before the
+#: event-driven steps resume.
+STEPPED_STEPS = 10
 
 
 @nb.njit(**JIT)
@@ -52,22 +67,24 @@ def event_values(y, P, cg, rg, ev, row, rate_row):
     qd = y[ly.N_DOF:ly.N_STATE]
     set_index = int(rg[ly.RG_SET])
     stick = rg[ly.RG_STICK] != 0.0
+    double_stick = stick and ly.SET_SECOND[set_index] >= 0
     for p in range(ly.N_POINTS):
         if in_set(set_index, p):
             ev[row, ly.EV_GAP + p] = 1.0
             ev[rate_row, ly.EV_GAP + p] = 0.0
-            ev[row, ly.EV_LAMBDA + p] = rg[ly.RG_LN + p] + LAMBDA_EPS
+            # a sticking double contact watches its split of forces in EV_STICK
+            ev[row, ly.EV_LAMBDA + p] = 1.0 if double_stick else rg[ly.RG_LN + p] + LAMBDA_EPS
         else:
-            ev[row, ly.EV_GAP + p] = cg[ly.CG_G + p, ly.CG_VAL] + GAP_EPS
+            ev[row, ly.EV_GAP + p] = cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p]
             ev[rate_row, ly.EV_GAP + p] = row_rate(cg, ly.CG_G + p, qd)
             ev[row, ly.EV_LAMBDA + p] = 1.0
     ev[row, ly.EV_STICK] = 1.0
     ev[row, ly.EV_SLIP] = 1.0
     if set_index > 0:
         if stick:
-            ev[row, ly.EV_STICK] = stick_margin(P, rg) + stick_tolerance(P, rg)
+            ev[row, ly.EV_STICK] = stick_margin(P, cg, rg) + stick_tolerance(P, rg)
         else:
-            rate = row_rate(cg, ly.CG_T + tangent_point(set_index, int(rg[ly.RG_TPT])), qd)
+            rate = row_rate(cg, ly.CG_T + tangent_point(set_index), qd)
             ev[row, ly.EV_SLIP] = rg[ly.RG_SIGN] * rate + RATE_EPS
 
 
@@ -230,97 +247,24 @@ def _log(log, n_log, t, kind, reg_from, reg_to, point):
 
 
 @nb.njit(**JIT)
-def impact(t, y, point, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, log, n_log, st):
-    """Momentum transfer at an impact of ``point`` (0-based) at state y (MODEL.md §7).
+def _accumulating(t, y, point, P, cg, st, dt, k1):
+    """Whether an impact of ``point`` at t belongs to an accumulation (MODEL.md §7).
 
-    rhs_regime must have run at y (M and its factor current).  Tries the
-    candidate regimes containing the point and otherwise only points that
-    are closed now; accepts the first with non-negative normal impulses,
-    sticking impulse inside the friction cone (or, sliding, no reversal of
-    the slip), no closed point approaching afterwards, and no kinetic
-    energy gained.  Writes the log row and leaves rg at the new regime (not
-    yet settled).  Returns a status.
+    Impacts recurring within ACCUM_STEPS steps, or a closing rate below
+    what the free gap acceleration makes in ACCUM_STEPS steps.
     """
+    if t - st[ly.ST_T_IMPACT] < ACCUM_STEPS * dt:
+        return True
     fill_geometry(y, P, cg)
-    old_set = int(rg[ly.RG_SET])
-    reg_from = regime_of(old_set, rg[ly.RG_STICK] != 0.0)
-    qd_minus = stages[ly.STAGE_QD, 0:ly.N_DOF]
-    qd_plus = stages[ly.STAGE_QD, ly.N_DOF:ly.N_STATE]
-    for j in range(ly.N_DOF):
-        qd_minus[j] = y[ly.N_DOF + j]
-    ke_minus = kinetic_energy(qd_minus, mat)
-    approach = abs(row_rate(cg, ly.CG_G + point, qd_minus))
-    tol_v = 1e-9 * approach + RATE_EPS
-    for cand in _IMPACT_ORDER:
-        if not in_set(cand, point):
-            continue
-        ok_members = True
-        for p in (ly.SET_FIRST[cand], ly.SET_SECOND[cand]):
-            if p >= 0 and p != point and not in_set(old_set, p) \
-                    and cg[ly.CG_G + p, ly.CG_VAL] > _CLOSED_GAP:
-                ok_members = False
-        if not ok_members:
-            continue
-        p1 = ly.SET_FIRST[cand]
-        n_normal = 1 if ly.SET_SECOND[cand] < 0 else 2
-        tau_minus = row_rate(cg, ly.CG_T + p1, qd_minus)
-        for mode in range(2):
-            stick = mode == 0
-            sign = 0.0
-            if not stick:
-                if tau_minus == 0.0:
-                    continue
-                sign = 1.0 if tau_minus > 0.0 else -1.0
-            m = apply_impulse(cand, stick, sign, 0, qd_minus, qd_plus, P, free, mat, cg, cw)
-            scale = 0.0
-            total_n = 0.0
-            for r in range(m):
-                scale = max(scale, abs(cw[ly.CW_D + r, ly.CW_L_COL]))
-            ok = True
-            for r in range(n_normal):
-                pn = cw[ly.CW_D + r, ly.CW_L_COL]
-                total_n += pn
-                if pn < -1e-12 * scale:
-                    ok = False
-            if stick and abs(cw[ly.CW_D + n_normal, ly.CW_L_COL]) > \
-                    P[ly.P_MU_S] * total_n * (1.0 + 1e-12) + 1e-300:
-                ok = False
-            if not stick and sign * row_rate(cg, ly.CG_T + p1, qd_plus) < -tol_v:
-                ok = False
-            for p in range(ly.N_POINTS):
-                if in_set(cand, p) or cg[ly.CG_G + p, ly.CG_VAL] > _CLOSED_GAP:
-                    continue
-                if row_rate(cg, ly.CG_G + p, qd_plus) < -tol_v:
-                    ok = False
-            ke_plus = kinetic_energy(qd_plus, mat)
-            if ke_plus > ke_minus * (1.0 + 1e-12):
-                ok = False
-            if not ok:
-                continue
-            for j in range(ly.N_DOF):
-                y[ly.N_DOF + j] = qd_plus[j]
-            rg[ly.RG_SET] = cand
-            rg[ly.RG_STICK] = 1.0 if stick else 0.0
-            rg[ly.RG_SIGN] = sign
-            rg[ly.RG_TPT] = 0.0
-            row = log[_log(log, n_log, t, ly.KIND_IMPACT, reg_from, regime_of(cand, stick),
-                           point + 1)]
-            row[ly.LOG_P + p1] = cw[ly.CW_D + 0, ly.CW_L_COL]
-            if n_normal == 2:
-                row[ly.LOG_P + ly.SET_SECOND[cand]] = cw[ly.CW_D + 1, ly.CW_L_COL]
-            if stick:
-                row[ly.LOG_PT] = cw[ly.CW_D + n_normal, ly.CW_L_COL]
-            else:
-                row[ly.LOG_PT] = -P[ly.P_MU_K] * sign * total_n
-            row[ly.LOG_DKE] = ke_minus - ke_plus
-            st[ly.ST_E_IMPACT] += ke_minus - ke_plus
-            st[ly.ST_N_IMPACTS] += 1.0
-            return ly.OK
-    return ly.ERR_NO_IMPACT_CANDIDATE
+    qd = y[ly.N_DOF:ly.N_STATE]
+    rate = row_rate(cg, ly.CG_G + point, qd)
+    acc = row_rate(cg, ly.CG_G + point, k1[ly.N_DOF:ly.N_STATE]) + row_convective(
+        cg, ly.CG_G + point, qd)
+    return abs(rate) < ACCUM_STEPS * abs(acc) * dt
 
 
 @nb.njit(**JIT)
-def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, log,
+def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, log,
                 n_log, st):
     """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
 
@@ -338,21 +282,41 @@ def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stage
         return status
     point = 0
     kind = ly.KIND_START
+    gap_tol = GAP_TOL
+    lost = 0.0
     if e < ly.EV_GAP + ly.N_POINTS:
-        status = impact(t, y, e - ly.EV_GAP, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                        stages, log, n_log, st)
+        p = e - ly.EV_GAP
+        accumulating = _accumulating(t, y, p, P, cg, st, dt, k1)
+        close_within = 0.0
+        if accumulating:
+            gap_tol = ACCUM_GAP_TOL
+            close_within = ACCUM_STEPS * dt
+        free_acc = stages[ly.STAGE_TRY]
+        status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, free_acc)
         if status != ly.OK:
             return status
+        status, n_pts, lost = impact(y, p, P, free, mat, cg, cw, rg, gap_tol,
+                                     free_acc[ly.N_DOF:ly.N_STATE], close_within)
+        if status != ly.OK:
+            return status
+        row = log[_log(log, n_log, t, ly.KIND_IMPACT, reg_from, 0, p + 1)]
+        for i in range(n_pts):
+            q = int(cw[ly.CW_PTS, i])
+            row[ly.LOG_P + q] = cw[ly.CW_P, 2 * i]
+            row[ly.LOG_PT] += cw[ly.CW_P, 2 * i + 1]
+        row[ly.LOG_DKE] = lost
+        st[ly.ST_E_IMPACT] += lost
+        st[ly.ST_N_IMPACTS] += 1.0
+        st[ly.ST_T_IMPACT] = t
+        if accumulating:
+            st[ly.ST_N_ACCUM] += 1.0
+            st[ly.ST_E_ACCUM] += lost
         kind = ly.KIND_IMPACT
-        point = e - ly.EV_GAP + 1
+        point = p + 1
     elif e < ly.EV_LAMBDA + ly.N_POINTS:
         p = e - ly.EV_LAMBDA
         keep = ly.SET_FIRST[set_index] if ly.SET_FIRST[set_index] != p else ly.SET_SECOND[set_index]
-        if keep >= 0 and tangent_point(set_index, int(rg[ly.RG_TPT])) == p:
-            rg[ly.RG_TPT] = 1.0 if keep == ly.SET_SECOND[set_index] else 0.0
-        else:
-            rg[ly.RG_SET] = 0.0 if keep < 0 else float(keep + 1)   # set {keep + 1}
-            rg[ly.RG_TPT] = 0.0
+        rg[ly.RG_SET] = 0.0 if keep < 0 else float(keep + 1)   # set {keep + 1}
         kind = ly.KIND_SEPARATION
         point = p + 1
     elif e == ly.EV_STICK:
@@ -364,20 +328,10 @@ def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stage
         rg[ly.RG_STICK] = 1.0
         kind = ly.KIND_SLIP_STICK
         point = ly.SET_FIRST[set_index] + 1
-    sign_before = rg[ly.RG_SIGN]
-    status = settle(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
+    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, k1, st,
+                           gap_tol)
     if status != ly.OK:
         return status
-    if (kind == ly.KIND_SLIP_STICK and int(rg[ly.RG_SET]) == set_index
-            and rg[ly.RG_STICK] == 0.0 and rg[ly.RG_SIGN] == sign_before):
-        # The slip decelerated to rest, yet sticking fails by round-off and
-        # would slip on the same way: at the friction limit, where stick and
-        # slip forces agree, so the contact sticks.
-        rg[ly.RG_STICK] = 1.0
-        project(y, P, free, cg, cw, rg)
-        status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
-        if status != ly.OK:
-            return status
     reg_to = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
     if kind == ly.KIND_IMPACT:
         log[n_log, ly.LOG_TO] = reg_to
@@ -390,11 +344,25 @@ def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stage
 
 @nb.njit(**JIT_INLINE)
 def _immediate_impact(ev):
-    """A watched gap already closed and closing at the current state (-1 if none)."""
+    """A watched gap already closed and closing faster than CLOSED_RATE (-1 if none)."""
     for p in range(ly.N_POINTS):
-        if ev[ly.EV_START, ly.EV_GAP + p] < 0.0 and ev[ly.EV_RATE_START, ly.EV_GAP + p] < 0.0:
+        if (ev[ly.EV_START, ly.EV_GAP + p] < 0.0
+                and ev[ly.EV_RATE_START, ly.EV_GAP + p] < -CLOSED_RATE):
             return ly.EV_GAP + p
     return -1
+
+
+@nb.njit(**JIT)
+def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, st):
+    """A Moreau-Jean step of h from (t, STAGE_CUR), then the regime chosen at t + h."""
+    status = moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st)
+    if status != ly.OK:
+        return status
+    status = choose_regime(t + h, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec, cg,
+                           cw, rg, stages, stages[ly.STAGE_K1], st, GAP_TOL)
+    if status == ly.OK:
+        event_values(stages[ly.STAGE_CUR], P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+    return status
 
 
 @nb.njit(**JIT)
@@ -441,7 +409,12 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
     stored = 0
     t = t0
     reg_start = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
-    status = settle(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages[ly.STAGE_K1])
+    if step0 == 0:
+        st[ly.ST_T_IMPACT] = -1e300
+        st[ly.ST_S_MIN] = y[ly.S]
+        st[ly.ST_S_MAX] = y[ly.S]
+    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages,
+                           stages[ly.STAGE_K1], st, GAP_TOL)
     if status != ly.OK:
         return status, stored, n_log
     event_values(y, P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
@@ -449,65 +422,77 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
         _log(log, n_log, t, ly.KIND_START, reg_start,
              regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
         n_log += 1
-    for _ in range(MAX_EVENTS_PER_STEP):
-        e = _immediate_impact(ev)
-        if e < 0:
-            break
-        status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages,
-                             log, n_log, st)
-        if status != ly.OK:
-            return status, stored, n_log
-        n_log += 1
     if step0 == 0:
         status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
                         out_t, out_y, out_sig)
         if status != ly.OK:
             return status, stored, n_log
         stored += 1
+    stepped_left = 0
     for step in range(1, n_steps + 1):
         if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
             return ly.LOG_FULL, stored, n_log
         t_end = t0 + step * dt
         n_step_events = 0
-        while True:
+        if stepped_left > 0:
+            status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
+                              stages, st)
+            if status != ly.OK:
+                st[ly.ST_T] = t
+                return status, stored, n_log
+            stepped_left -= 1
+            t = t_end
+        while stepped_left == 0:
             h = t_end - t
             if h <= 1e-15 * dt:
                 break
-            status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages,
-                              stages[ly.STAGE_NEXT])
-            if status == ly.OK:
-                drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
-                st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
-                status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec, mat,
-                                    vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
-            if status != ly.OK:
-                return status, stored, n_log
-            event_values(stages[ly.STAGE_NEXT], P, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-            status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
-                                      stages)
-            if status != ly.OK:
-                return status, stored, n_log
+            e = _immediate_impact(ev)
             if e < 0:
-                _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
-                _copy(stages, ly.STAGE_KNEXT, ly.STAGE_K1)
-                _copy_ev(ev, ly.EV_END, ly.EV_START)
-                for p in range(ly.N_POINTS):
-                    ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
-                t = t_end
-                break
-            _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
-            t = t_end if theta >= 1.0 else t + theta * h
-            while e >= 0:
-                n_step_events += 1
-                if n_step_events > MAX_EVENTS_PER_STEP:
-                    st[ly.ST_T] = t
-                    return ly.ERR_EVENT_FLOOD, stored, n_log
+                status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                                  stages, stages[ly.STAGE_NEXT])
+                if status == ly.OK:
+                    drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
+                    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+                    status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec,
+                                        mat, vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
+                if status != ly.OK:
+                    return status, stored, n_log
+                event_values(stages[ly.STAGE_NEXT], P, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+                status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                                          ev, stages)
+                if status != ly.OK:
+                    return status, stored, n_log
+                if e < 0:
+                    _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+                    _copy(stages, ly.STAGE_KNEXT, ly.STAGE_K1)
+                    _copy_ev(ev, ly.EV_END, ly.EV_START)
+                    for p in range(ly.N_POINTS):
+                        ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+                    t = t_end
+                    break
+                _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
+                t = t_end if theta >= 1.0 else t + theta * h
                 for p in range(ly.N_POINTS):       # penetration when the event is found
                     if not in_set(int(rg[ly.RG_SET]), p):
                         st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN],
-                                                GAP_EPS - ev[ly.EV_HI, ly.EV_GAP + p])
-                status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
-                                     stages, log, n_log, st)
+                                                rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p])
+            while e >= 0:
+                n_step_events += 1
+                if n_step_events > MAX_EVENTS_PER_STEP:
+                    # an episode the event-driven logic cannot resolve: Moreau-Jean
+                    # time-stepping through the rest of this step and STEPPED_STEPS more
+                    status = ly.OK
+                    if t_end - t > 1e-15 * dt:
+                        status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, cg,
+                                          cw, rg, ev, stages, st)
+                    if status != ly.OK:
+                        st[ly.ST_T] = t
+                        return status, stored, n_log
+                    t = t_end
+                    stepped_left = STEPPED_STEPS
+                    break
+                status = apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                                     ev, stages, log, n_log, st)
                 if status != ly.OK:
                     st[ly.ST_T] = t
                     return status, stored, n_log
@@ -515,7 +500,10 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                 e = _immediate_impact(ev)
         for p in range(ly.N_POINTS):
             if not in_set(int(rg[ly.RG_SET]), p):
-                st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN], GAP_EPS - ev[ly.EV_START, ly.EV_GAP + p])
+                st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN],
+                                        rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p])
+        st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
+        st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
         st[ly.ST_T] = t
         st[ly.ST_STEP] = step0 + step
         if (step0 + step) % decim == 0:

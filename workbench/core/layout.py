@@ -32,8 +32,8 @@ P_EI_A = 6       # beam A bending stiffness (g cm^3/s^2)
 P_EI_B = 7       # beam B bending stiffness (g cm^3/s^2)
 P_EA_A = 8       # beam A axial stiffness (g cm/s^2)
 P_EA_B = 9       # beam B axial stiffness (g cm/s^2)
-P_BETA_A = 10    # beam A stiffness-proportional damping (s)
-P_BETA_B = 11    # beam B stiffness-proportional damping (s)
+P_BETA_A = 10    # beam A bending damping C_b = beta K_b (s)
+P_BETA_B = 11    # beam B bending damping (s)
 P_M3 = 12        # joint body mass (g)
 P_I3 = 13        # joint body inertia about its CM (g cm^2)
 P_C3 = 14        # joint body CM along the joint axis (cm)
@@ -60,7 +60,11 @@ P_C_STRAIN = 34  # distance from the neutral axis to the surface (cm)
 P_N_GAUSS = 35   # Gauss points per beam (stored as a float)
 P_X_ACCEL1 = 36  # accel1 on the joint body, from its base (cm)
 P_X_ACCEL2 = 37  # accel2 on the loose body, from its inner end (cm)
-N_PARAMS = 38
+P_C_AX_A = 38    # beam A axial damping on u_A (g/s)
+P_C_AX_B = 39    # beam B axial damping on u_B (g/s)
+P_S_TRAVEL = 40  # slide before the slot's end stop, each way (cm; inf for none)
+P_K_STOP = 41    # end-stop stiffness beyond |s| > s_travel (g/s^2)
+N_PARAMS = 42
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):
@@ -209,19 +213,32 @@ RG_SIGN = 2      # slipping: sign of tau' of the set's points (+1 or -1)
 RG_LN = 3        # RG_LN + k: normal force lambda_n of point k + 1 (dyn), 0 if open
 RG_LT = RG_LN + N_POINTS   # sticking: tangential force lambda_t (dyn)
 RG_VGRAV = RG_LT + 1       # gravitational energy of the last state (erg)
-RG_TPT = RG_VGRAV + 1      # sticking: whose tangential row, 0 the set's first point, 1 its second
-N_RG = RG_TPT + 1
+RG_ARM = RG_VGRAV + 1      # RG_ARM + k: an open gap's impact fires at g_k < -rg[RG_ARM + k] (cm)
+N_RG = RG_ARM + N_POINTS
 
-# Constraint work array cw (N_CW, 9): up to 3 constraint rows A, their force
-# directions B (A when sticking; W_n - mu sigma W_t when slipping), the
-# columns X = M^-1 B^T, and a small dense system D lambda = c.
-MAX_ROWS = 3
+# Constraint work array cw (N_CW, N_CW_COLS): up to 4 constraint rows A (the
+# normal and tangential rows of two points), their force directions B (A when
+# sticking; W_n - mu sigma W_t when slipping), the columns X = M^-1 B^T, a
+# small dense system D lambda = c; then the impact law's Delassus matrix G,
+# rates u, impulses P, modes and friction coefficients, and its scratch rows
+# (workbench.core.impact_law).  Rows A, B, X use the first N_DOF columns.
+MAX_ROWS = 4
 CW_A = 0
 CW_B = CW_A + MAX_ROWS
 CW_X = CW_B + MAX_ROWS
-CW_D = CW_X + MAX_ROWS       # rows CW_D..: D in columns 0..2, c in column 3, lambda in 4
+CW_D = CW_X + MAX_ROWS       # rows CW_D..: D in columns 0..3, c in column 4, lambda in 5
 CW_C_COL, CW_L_COL = MAX_ROWS, MAX_ROWS + 1
-N_CW = CW_D + MAX_ROWS
+CW_G = CW_D + MAX_ROWS       # rows CW_G..CW_G + 3: G in columns 0..3
+CW_U = CW_G + MAX_ROWS       # u- (cm/s) of the impact rows
+CW_P = CW_U + 1              # impulses P (dyn s)
+CW_MODES = CW_P + 1          # per point: impact_law.OPEN, STICK, SLIP_POS, SLIP_NEG
+CW_MU = CW_MODES + 1         # per point: mu
+CW_PTS = CW_MU + 1           # the impact set's points (0-based), -1 for none
+N_LAW = 23                   # scratch rows of the impact law
+N_LAW_COLS = 18              # its columns: Lemke's tableau of 8 unknowns
+CW_LAW = CW_PTS + 1
+N_CW = CW_LAW + N_LAW
+N_CW_COLS = N_LAW_COLS
 
 # Event values ev (N_EV_ROWS, N_EV): every event function changes sign from
 # + to - when its event happens; functions not watched in a regime are +1.
@@ -256,7 +273,17 @@ ST_N_IMPACTS = 3
 ST_E_IMPACT = 4      # kinetic energy lost in impacts (erg)
 ST_T = 5             # time reached (s)
 ST_STEP = 6          # steps completed
-N_ST = 7
+ST_N_ACCUM = 7       # accumulations of impacts closed by a full-set impact (MODEL.md §7)
+ST_E_ACCUM = 8       # kinetic energy those impacts removed (erg; also in ST_E_IMPACT)
+ST_N_INCONSISTENT = 9    # states with no consistent regime resolved by the impact law
+ST_E_INCONSISTENT = 10   # kinetic energy those impulses removed (erg; also in ST_E_IMPACT)
+ST_N_UNRESOLVED = 11     # states left in the least violated regime
+ST_N_STEPPED = 12    # steps taken by Moreau-Jean time-stepping (event flood)
+ST_E_STEPPED = 13    # kinetic energy its impulses removed (erg; also in ST_E_IMPACT)
+ST_S_MIN = 14        # smallest slide s at an accepted step (cm)
+ST_S_MAX = 15        # largest slide s (cm)
+ST_T_IMPACT = 16     # time of the last impact (s)
+N_ST = 17
 
 # Signals stored at the output rate (out_sig columns), CGS units.
 SIGNALS = ("force1", "hammer", "strain1", "strain2", "accel1", "accel2", "accel3", "tip_y",

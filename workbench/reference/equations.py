@@ -150,7 +150,9 @@ class Reference:
             blk[2, 2] = E * A / L
             omega1 = 3.516 / L ** 2 * np.sqrt(E * I / mu)
             K[i0:i0 + 3, i0:i0 + 3] = blk
-            C[i0:i0 + 3, i0:i0 + 3] = 2 * zeta / omega1 * blk
+            C[i0:i0 + 2, i0:i0 + 2] = 2 * zeta / omega1 * blk[:2, :2]
+            # the axial coordinate's own mode at the same zeta (MODEL.md §5)
+            C[i0 + 2, i0 + 2] = 2 * zeta * np.sqrt(blk[2, 2] * p.axial_mass("a" if i0 == 0 else "b"))
         K[4, 4] = p.k_v
         K[5, 5] = p.k_psi
         return K, C
@@ -196,8 +198,10 @@ class Reference:
         return M, h, Qg, Vg
 
     def cork(self, s, sd):
+        """Cork spring and damper plus the slot's end stop (MODEL.md §6)."""
         n, k, c = self.p.cork_law
-        return k * np.sign(s) * abs(s) ** n + c * sd
+        over = max(abs(s) - self.p.s_travel, 0.0)
+        return k * np.sign(s) * abs(s) ** n + self.p.k_stop * np.sign(s) * over + c * sd
 
     def generalized(self, t, q, qd):
         """M and the generalized force Q - h (applied, elastic, damping, cork, inertial)."""
@@ -227,7 +231,9 @@ class Reference:
         q, qd = y[:N], y[N:]
         M, _, _, Vg = self.inertia(q, qd)
         n, k, _ = self.p.cork_law
-        return 0.5 * qd @ M @ qd + 0.5 * q @ self.K @ q + Vg + k * abs(q[3]) ** (n + 1) / (n + 1)
+        over = max(abs(q[3]) - self.p.s_travel, 0.0)
+        return (0.5 * qd @ M @ qd + 0.5 * q @ self.K @ q + Vg + k * abs(q[3]) ** (n + 1) / (n + 1)
+                + 0.5 * self.p.k_stop * over ** 2)
 
     def integrate(self, y0, t_eval, rtol=1e-11, atol=1e-13, method="DOP853"):
         sol = solve_ivp(self.rhs, (t_eval[0], t_eval[-1]), y0, method=method, t_eval=t_eval,

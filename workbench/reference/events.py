@@ -13,12 +13,12 @@ benchmarks measure the kernels against it (benchmarks/, issue 6):
   [[M, -B^T], [A, 0]] [q'', lambda] = [Q - h, -A' q'] by numpy.linalg.solve;
 * events are scipy's terminal events, located on the dense output.
 
-The transition *rules* are those of MODEL.md §7 with the workbench's
-documented choices (README "Deviations"): the candidate order of an impact,
-the shared tangential row of a double contact, and a sticking double
-contact moving its tangential row to the point that stays before the other
-separates.  The kernel's small thresholds (GAP_EPS, LAMBDA_EPS, ...) shift
-event times by far less than the 1e-6 s the comparison allows.
+The transition *rules* are those of MODEL.md §7 and the kernel's: the same
+impact law (:func:`workbench.core.impact_law.eval_impact`, on Delassus
+matrices built here from the jets), the same enumeration of regimes in the
+same order with the same tolerances, and the shared tangential row of a
+double contact.  The kernel's small thresholds (GAP_EPS, LAMBDA_EPS, ...)
+shift event times by far less than the 1e-6 s the comparison allows.
 """
 from __future__ import annotations
 
@@ -26,14 +26,24 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.linalg import null_space
 
+from ..config import FRICTION_REL_EPS, LAMBDA_EPS
+from ..core.impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, eval_impact
+from ..core.transitions import CLOSED_RATE, GAP_TOL, REGIME_REL_TOL, REST_RATE
 from .equations import N, Jet, Reference, jcos, jsin
 
 #: Contact sets (0-based points) in the order of MODEL.md §7; index = set number.
 SETS = ((), (0,), (1,), (2,), (3,), (0, 2), (0, 3), (1, 2), (1, 3))
-#: Impact candidates: double contacts first (MODEL.md §7 "enumerate").
-IMPACT_ORDER = (5, 6, 7, 8, 1, 2, 3, 4)
-CLOSED = 1e-9          # cm: a gap this small may join an impact
+
+
+def _incompatible(points):
+    """1 with 2, or 3 with 4: the pairs that cannot touch together."""
+    return set(points) in ({0, 1}, {2, 3})
+
+
+def _compatible(points, k):
+    return len(points) == 0 or (len(points) == 1 and not _incompatible([points[0], k]))
 
 
 @dataclass(frozen=True)
@@ -41,7 +51,6 @@ class Regime:
     set_index: int = 0
     stick: bool = False
     sign: float = 0.0      # slip direction sigma of tau'
-    tpt: int = 0           # which point of a double contact holds the tangential row
 
     @property
     def number(self):
@@ -55,8 +64,8 @@ class Regime:
 
     @property
     def tangent(self):
-        pts = self.points
-        return pts[1] if (self.tpt == 1 and len(pts) == 2) else pts[0]
+        """The point whose tangential row a sticking regime holds: the set's first."""
+        return self.points[0]
 
 
 def set_number(points):
@@ -129,7 +138,7 @@ class HybridReference:
         friction = 0.0 if reg.stick else -self.p.mu_k * reg.sign
         for k in reg.points:
             A.append(g[k].g[0])
-            B.append(g[k].g[0] + friction * T.g[0])
+            B.append(g[k].g[0] + friction * tau[k].g[0])       # each point its own friction
             conv.append(g[k].d2[0])
         if reg.stick:
             A.append(T.g[0])
@@ -171,9 +180,33 @@ class HybridReference:
         return out
 
     def margin(self, t, y, reg):
-        """mu_s sum lambda_n - |lambda_t| (dyn)."""
+        """How far a sticking regime is inside the friction cone (dyn), as MODEL.md §7 reads.
+
+        One point: mu_s lambda_n - |lambda_t|.  Two points: the width of the
+        interval of splits alpha (along the unit null vector of the rows n1,
+        t1, n2, t2) that keep lambda_n,k >= 0 and |lambda_t,k| <= mu_s
+        lambda_n,k at both points.
+        """
         _, lam_n, lam_t = self.solve(t, y, reg)
-        return self.p.mu_s * lam_n.sum() - abs(lam_t)
+        mu = self.p.mu_s
+        if len(reg.points) == 1:
+            return mu * lam_n.sum() - abs(lam_t)
+        k1, k2 = reg.points
+        g, tau = self.contact(y[:N], y[N:])
+        rows = np.array([g[k1].g[0], tau[k1].g[0], g[k2].g[0], tau[k2].g[0]])[:, 3:6]
+        d = null_space(rows.T)[:, 0]
+        d /= np.abs(d).max()
+        x0 = np.array([lam_n[k1], lam_t, lam_n[k2], 0.0])
+        # conditions C (x0 + alpha d) >= 0: an interval of alpha
+        C = np.array([[1, 0, 0, 0], [mu, -1, 0, 0], [mu, 1, 0, 0],
+                      [0, 0, 1, 0], [0, 0, mu, -1], [0, 0, mu, 1]], dtype=float)
+        c, dd = C @ x0, C @ d
+        fixed = dd == 0.0
+        if np.any(c[fixed] < 0.0):
+            return float(c[fixed].min())
+        lo = np.max(-c[dd > 0] / dd[dd > 0], initial=-np.inf)
+        hi = np.min(-c[dd < 0] / dd[dd < 0], initial=np.inf)
+        return float(min(hi - lo, 1e300))
 
     def slip_rate(self, y, reg):
         _, tau = self.contact(y[:N], y[N:])
@@ -188,9 +221,11 @@ class HybridReference:
             fun.kind, fun.point = kind, point
             evs.append(fun)
 
+        double_stick = reg.stick and len(reg.points) == 2
         for k in range(4):
             if k in reg.points:
-                add(lambda t, y, k=k: self.solve(t, y, reg)[1][k], "separation", k)
+                if not double_stick:         # a sticking pair watches its split in the margin
+                    add(lambda t, y, k=k: self.solve(t, y, reg)[1][k], "separation", k)
             else:
                 add(lambda t, y, k=k: self.contact(y[:N], y[N:])[0][k].v[0], "impact", k)
         if reg.set_index and reg.stick:
@@ -200,72 +235,135 @@ class HybridReference:
         return evs
 
     # ---- transitions (MODEL.md §7) -------------------------------------------------
-    def impact(self, t, y, point, reg):
-        """Momentum transfer: the first consistent candidate; returns (y+, regime, ke lost)."""
+    def closed_points(self, g, point, reg, gap_tol, rate_tol):
+        """The event point, the regime's points, then the nearest open points within gap_tol.
+
+        rate_tol < 0 takes any normal rate; otherwise only points at rest.
+        """
+        pts = [] if point is None else [point]
+        pts += [k for k in reg.points if k not in pts and _compatible(pts, k)]
+        for _ in range(2):
+            near = [k for k in range(4) if k not in pts and g[k].v[0] <= gap_tol
+                    and _compatible(pts, k) and (rate_tol < 0 or abs(g[k].d1[0]) <= rate_tol)]
+            if near:
+                pts.append(min(near, key=lambda k: g[k].v[0]))
+        return pts[:2]
+
+    def impact(self, t, y, point, reg, gap_tol=GAP_TOL):
+        """Moreau's impact law over the impact set (the kernel's law, workbench.core.impact_law).
+
+        Returns (y+, regime read from the solution, kinetic energy lost).
+        """
         q, qd = y[:N], y[N:]
         M, _ = self.model.generalized(t, q, qd)
         f = self.free
         g, tau = self.contact(q, qd)
-        ke = 0.5 * qd @ M @ qd
-        tol = 1e-9 * abs(g[point].d1[0]) + 1e-10
-        for cand in IMPACT_ORDER:
-            pts = SETS[cand]
-            if point not in pts or any(k != point and k not in reg.points and g[k].v[0] > CLOSED
-                                       for k in pts):
-                continue
-            rate = tau[pts[0]].d1[0]
-            for stick in (True, False):
-                if not stick and rate == 0.0:
-                    continue
-                r = Regime(cand, stick, 0.0 if stick else float(np.sign(rate)))
-                A, B, _, _, _ = self.rows(q, qd, r)
-                n = len(f)
-                x = self._kkt_solve(M, A, B, np.zeros(n), -A @ qd)
-                qd_plus = qd.copy()
-                qd_plus[f] += x[:n]
-                P = x[n:]
-                Pn = P[:len(pts)]
-                ok = (Pn >= -1e-12 * np.abs(P).max()).all()
-                if stick:
-                    ok &= abs(P[-1]) <= self.p.mu_s * Pn.sum() * (1 + 1e-12)
-                else:
-                    ok &= r.sign * (tau[pts[0]].g[0] @ qd_plus) >= -tol
-                for k in range(4):
-                    if k not in pts and g[k].v[0] <= CLOSED:
-                        ok &= g[k].g[0] @ qd_plus >= -tol
-                ke_plus = 0.5 * qd_plus @ M @ qd_plus
-                ok &= ke_plus <= ke * (1 + 1e-12)
-                if ok:
-                    return np.concatenate([q, qd_plus]), r, ke - ke_plus
-        raise RuntimeError(f"no consistent impact candidate at t = {t}")
+        pts = self.closed_points(g, point, reg, gap_tol, -1.0)
+        if not pts:
+            return y, reg, 0.0
+        W = np.array([row for k in pts for row in (g[k].g[0], tau[k].g[0])])
+        X = np.zeros((N, len(W)))
+        X[f] = np.linalg.solve(M[np.ix_(f, f)], W[:, f].T)
+        source, P, modes = eval_impact(W @ X, W @ qd, np.full(len(pts), self.p.mu_k), len(pts))
+        if source == NOT_FOUND:
+            raise RuntimeError(f"the impact law found no solution at t = {t}")
+        qd_plus = qd + X @ P
+        closed = [(k, mode) for k, mode in zip(pts, modes) if mode != OPEN]
+        new = Regime()
+        if closed:
+            stick = all(mode == STICK for _, mode in closed)
+            slips = [mode for _, mode in closed if mode != STICK]
+            sign = 1.0 if not slips or slips[0] == SLIP_POS else -1.0
+            new = Regime(set_number([k for k, _ in closed]), stick, sign)
+            if not stick:
+                rate = tau[new.tangent].g[0] @ qd_plus
+                if abs(rate) > REST_RATE:
+                    new = replace(new, sign=float(np.sign(rate)))
+        ke = 0.5 * qd @ M @ qd - 0.5 * qd_plus @ M @ qd_plus
+        return np.concatenate([q, qd_plus]), new, ke
 
-    def settle(self, t, y, reg):
-        """The consistent regime at y without a velocity jump (as MODEL.md §7 reads)."""
-        for _ in range(12):
-            if reg.set_index == 0:
-                return reg
-            if not reg.stick:
-                rate = self.slip_rate(y, reg)
-                if abs(rate) > 1e-10:
+    def violation(self, t, y, reg, pts, slip_from_rest):
+        """How far a regime is from consistent (<= 0: consistent), as the kernel measures it."""
+        q, qd = y[:N], y[N:]
+        ydot, lam_n, lam_t = self.solve(t, y, reg)
+        qdd = ydot[N:]
+        g, tau = self.contact(q, qd)
+        f_scale = max(LAMBDA_EPS, np.abs(lam_n).max(), abs(lam_t))
+        acc = {k: g[k].g[0] @ qdd + g[k].d2[0] for k in pts}
+        a_scale = max([1e-9] + [abs(a) for a in acc.values()])
+        worst = -1.0
+        double_stick = reg.stick and len(reg.points) == 2
+        for k in pts:
+            if k in reg.points and double_stick:
+                continue                              # the split is in the margin
+            worst = max(worst, -(lam_n[k] + LAMBDA_EPS) / f_scale if k in reg.points
+                        else -acc[k] / a_scale)
+        if reg.set_index and reg.stick:
+            tol = FRICTION_REL_EPS * self.p.mu_s * np.abs(lam_n).sum() + LAMBDA_EPS
+            worst = max(worst, -(self.margin(t, y, reg) + 0.5 * tol) / f_scale)
+        elif reg.set_index and slip_from_rest:
+            T = tau[reg.points[0]]
+            at = T.g[0] @ qdd + T.d2[0]
+            worst = max(worst, -reg.sign * at / max(a_scale, abs(at)))
+        return worst - REGIME_REL_TOL
+
+    def candidates(self, y, proposal, pts):
+        """(regime, slip from rest) in the kernel's order: the proposal, then subsets largest first."""
+        q, qd = y[:N], y[N:]
+        _, tau = self.contact(q, qd)
+        out = []
+        if all(k in pts for k in proposal.points):
+            reg = proposal
+            if reg.set_index:
+                rate = tau[reg.points[0]].d1[0]
+                rest = abs(rate) <= REST_RATE
+                if not reg.stick and not rest:
                     reg = replace(reg, sign=float(np.sign(rate)))
-            _, lam_n, lam_t = self.solve(t, y, reg)
-            worst = min(reg.points, key=lambda k: lam_n[k])
-            if lam_n[worst] < -1e-6:
-                reg = self.drop(reg, worst)
+                if not (reg.stick and not rest):
+                    out.append((reg, not reg.stick and rest))
+            else:
+                out.append((reg, False))
+        m = len(pts)
+        for mask in range((1 << m) - 1, -1, -1):
+            chosen = [pts[i] for i in range(m) if mask & (1 << i)]
+            if not chosen:
+                out.append((Regime(), False))
                 continue
-            if reg.stick and self.margin(t, y, reg) < 0.0:
-                reg = Regime(reg.set_index, False, -float(np.sign(lam_t)), reg.tpt)
+            if len(chosen) == 2 and _incompatible(chosen):
                 continue
-            return reg
-        raise RuntimeError(f"no consistent regime at t = {t}")
+            k = set_number(chosen)
+            rate = tau[SETS[k][0]].d1[0]
+            rest = abs(rate) <= REST_RATE
+            if rest:
+                out += [(Regime(k, True, 1.0), False), (Regime(k, False, 1.0), True),
+                        (Regime(k, False, -1.0), True)]
+            else:
+                out.append((Regime(k, False, float(np.sign(rate))), False))
+        return out
 
-    @staticmethod
-    def drop(reg, point):
-        """Separation of ``point``; a sticking double contact first moves its row off it."""
-        keep = [k for k in reg.points if k != point]
-        if keep and reg.stick and reg.tangent == point:
-            return replace(reg, tpt=1 - reg.tpt)
-        return Regime(set_number(keep), reg.stick, reg.sign) if keep else Regime()
+    def choose(self, t, y, proposal, gap_tol=GAP_TOL):
+        """The regime at y by the acceleration-level enumeration (the kernel's choose_regime).
+
+        No consistent regime: the impact law at zero approach, then again;
+        then the least violated.  Returns (y, regime, kinetic energy lost).
+        """
+        lost = 0.0
+        reg = proposal
+        for attempt in range(2):
+            g, _ = self.contact(y[:N], y[N:])
+            pts = self.closed_points(g, None, reg, gap_tol, CLOSED_RATE)
+            scored = []
+            for cand, from_rest in self.candidates(y, reg, pts):
+                v = self.violation(t, y, cand, pts, from_rest)
+                if v <= 0.0:
+                    return y, cand, lost
+                scored.append((v, len(scored), cand))
+            reg = min(scored)[2]
+            if attempt == 1 or not pts:
+                break
+            y, reg, ke = self.impact(t, y, None, reg, gap_tol)
+            lost += ke
+        return y, reg, lost
 
     def transition(self, t, y, ev, reg):
         """Apply event ``ev``; returns (y, new regime, log row)."""
@@ -273,18 +371,17 @@ class HybridReference:
         if ev.kind == "impact":
             y, new, ke_lost = self.impact(t, y, ev.point, reg)
         elif ev.kind == "separation":
-            new = self.drop(reg, ev.point)
+            keep = [k for k in reg.points if k != ev.point]
+            new = Regime(set_number(keep), reg.stick, reg.sign) if keep else Regime()
         elif ev.kind == "stick-slip":
             _, _, lam_t = self.solve(t, y, reg)
-            new = Regime(reg.set_index, False, -float(np.sign(lam_t)), reg.tpt)
+            new = Regime(reg.set_index, False, -float(np.sign(lam_t)))
         else:
             new = replace(reg, stick=True)
-        settled = self.settle(t, y, new)
-        if (ev.kind == "slip-stick" and settled.set_index == reg.set_index
-                and not settled.stick and settled.sign == reg.sign):
-            settled = replace(settled, stick=True)     # at the friction limit: stick
-        return y, settled, dict(t=t, kind=ev.kind, from_regime=reg.number,
-                                to_regime=settled.number, point=ev.point + 1, ke_lost=ke_lost)
+        y, chosen, lost = self.choose(t, y, new)
+        return y, chosen, dict(t=t, kind=ev.kind, from_regime=reg.number,
+                               to_regime=chosen.number, point=ev.point + 1,
+                               ke_lost=ke_lost + lost)
 
     # ---- the run ---------------------------------------------------------------------
     def run(self, t0, t1, y0, reg=Regime(), max_events=100, t_eval=None):
@@ -295,7 +392,7 @@ class HybridReference:
         the states at those times.
         """
         t, y = t0, np.array(y0, dtype=float)
-        reg = self.settle(t, y, reg)
+        y, reg, _ = self.choose(t, y, reg)
         log = []
         want = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=float)
         want = want[(want >= t0) & (want <= t1 + 1e-12 * max(1.0, abs(t1)))]

@@ -1,0 +1,226 @@
+"""Moreau's impact law (workbench.core.impact_law) alone, without the model's geometry.
+
+Closed forms: the oblique plastic impact of a ball, a rigid rod landing flat on
+two supports, and Housner's rocking block.  A hypothesis test over random
+Delassus matrices checks every complementarity condition, that kinetic energy
+never rises, and agreement with an independent slow LCP solve (below: every
+complementary basis of the Stewart-Trinkle LCP tried by linear programming).
+"""
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from scipy.optimize import linprog
+
+from workbench.core import layout as ly
+from workbench.core.impact_law import (FOUND_ENUMERATION, NOT_FOUND, OPEN, SLIP_NEG, SLIP_POS,
+                                       STICK, energy_change, eval_impact, lemke_impact)
+
+
+def delassus(W, Minv):
+    return W @ Minv @ W.T
+
+
+def check_conditions(G, u, mu, m, P, tol=1e-7):
+    """Assert Moreau's law at every point: plastic, in the cone, slip opposed by friction."""
+    up = u + G @ P
+    scale_u = max(np.abs(u).max(), 1e-12)
+    scale_p = max(np.abs(P).max(), scale_u / max(np.abs(np.diag(G)).max(), 1e-12))
+    for i in range(m):
+        pn, pt = P[2 * i], P[2 * i + 1]
+        un, ut = up[2 * i], up[2 * i + 1]
+        assert pn >= -tol * scale_p
+        assert un >= -tol * scale_u
+        assert abs(pn * un) <= tol * scale_p * scale_u          # 0 <= u_n+ _|_ P_n >= 0
+        assert abs(pt) <= mu[i] * pn + tol * scale_p              # the cone
+        if abs(ut) > tol * scale_u:                               # post-impact slip
+            assert pt == pytest.approx(-mu[i] * pn * np.sign(ut), abs=tol * scale_p)
+    return up
+
+
+# --- closed forms -------------------------------------------------------------------------
+
+@pytest.mark.parametrize("vn, vt, mu", [(-2.0, 3.0, 0.3), (-2.0, 0.5, 0.3), (-1.0, -4.0, 0.5),
+                                        (-3.0, 0.0, 0.2), (-1.0, 2.0, 0.0)])
+def test_ball_oblique_plastic_impact(vn, vt, mu):
+    """A ball at e = 0: v_t+ = sign(v_t) max(|v_t| - mu |v_n|, 0), v_n+ = 0 (Stronge 2000, §3)."""
+    mass = 2.5
+    G = np.eye(2) / mass
+    u = np.array([vn, vt])
+    source, P, modes = eval_impact(G, u, np.array([mu]), 1)
+    assert source == FOUND_ENUMERATION
+    up = check_conditions(G, u, [mu], 1, P)
+    assert up[0] == pytest.approx(0.0, abs=1e-12)
+    assert up[1] == pytest.approx(np.sign(vt) * max(abs(vt) - mu * abs(vn), 0.0), abs=1e-12)
+    assert modes[0] == (STICK if abs(vt) <= mu * abs(vn) else (SLIP_POS if vt > 0 else SLIP_NEG))
+
+
+def rod(mass=2.0, inertia=0.5, a=1.0):
+    """A rod (x, y, theta) with supports under x = -a (point 1) and x = +a (point 2), flat."""
+    W = np.array([[0.0, 1.0, -a], [1.0, 0.0, 0.0], [0.0, 1.0, a], [1.0, 0.0, 0.0]])
+    return W, np.diag([1 / mass, 1 / mass, 1 / inertia])
+
+
+@pytest.mark.parametrize("xd, yd, thd", [(0.7, -1.0, 0.1), (0.0, -2.0, -0.5), (0.3, -1.0, 0.0)])
+def test_rod_landing_flat_stops_dead(xd, yd, thd):
+    """Both closed-form impulses >= 0: the rod stops dead (y' = theta' = 0), x' loses mu sum P_n / m.
+
+    Sum P_n = -m y', a (P_2 - P_1) = -I theta' (impulse-momentum of the rigid rod).
+    """
+    mass, inertia, a, mu = 2.0, 0.5, 1.0, 0.5
+    W, Minv = rod(mass, inertia, a)
+    qd = np.array([xd, yd, thd])
+    p1 = 0.5 * (-mass * yd + inertia * thd / a)
+    p2 = 0.5 * (-mass * yd - inertia * thd / a)
+    assert p1 >= 0 and p2 >= 0
+    G = delassus(W, Minv)
+    source, P, _ = eval_impact(G, W @ qd, np.array([mu, mu]), 2)
+    check_conditions(G, W @ qd, [mu, mu], 2, P)
+    qd_plus = qd + Minv @ W.T @ P
+    assert qd_plus[1:] == pytest.approx([0.0, 0.0], abs=1e-12)
+    assert [P[0], P[2]] == pytest.approx([p1, p2], rel=1e-10)
+    assert qd_plus[0] == pytest.approx(np.sign(xd) * max(abs(xd) - mu * (p1 + p2) / mass, 0.0),
+                                       abs=1e-12)
+
+
+def test_rod_landing_rotating_rocks_about_one_support():
+    """One closed-form impulse < 0: only point 1 takes the impact and the rod rocks about it.
+
+    Angular momentum about point 1 is conserved: (I + m a^2) w+ = I theta' + m a y'
+    (sticking at point 1, mu large); point 2 leaves.
+    """
+    mass, inertia, a, mu = 2.0, 0.5, 1.0, 5.0
+    W, Minv = rod(mass, inertia, a)
+    qd = np.array([0.0, -0.2, 3.0])
+    assert 0.5 * (-mass * qd[1] - inertia * qd[2] / a) < 0
+    G = delassus(W, Minv)
+    source, P, modes = eval_impact(G, W @ qd, np.array([mu, mu]), 2)
+    up = check_conditions(G, W @ qd, [mu, mu], 2, P)
+    w_plus = (inertia * qd[2] + mass * a * qd[1]) / (inertia + mass * a * a)
+    qd_plus = qd + Minv @ W.T @ P
+    assert qd_plus[2] == pytest.approx(w_plus, rel=1e-10)
+    assert list(modes) == [STICK, OPEN] and up[2] > 0 and P[2] == 0.0
+
+
+@pytest.mark.parametrize("b, h", [(0.2, 1.0), (0.5, 1.5), (1.0, 2.0)])
+def test_housner_rocking_block(b, h):
+    """Housner (1963): a block rocking onto its other corner keeps r = 1 - 1.5 sin^2 alpha of w.
+
+    Uniform block 2b x 2h, I_cm = m (b^2 + h^2) / 3, alpha = atan(b / h), plastic impact
+    without slip; at the flat position rotating about corner 2 at w-, corner 1 lands.
+    """
+    mass = 3.0
+    inertia = mass * (b * b + h * h) / 3.0
+    Minv = np.diag([1 / mass, 1 / mass, 1 / inertia])
+    # points rho_1 = (-b, -h), rho_2 = (b, -h): normal row (0, 1, rho_x), tangential (1, 0, -rho_y)
+    W = np.array([[0.0, 1.0, -b], [1.0, 0.0, h], [0.0, 1.0, b], [1.0, 0.0, h]])
+    w = 1.7
+    qd = np.array([-h * w, -b * w, w])          # about corner 2: v_cm = w z x (-b, h)
+    G = delassus(W, Minv)
+    u = W @ qd
+    assert u[2] == pytest.approx(0.0, abs=1e-12) and u[0] < 0
+    source, P, modes = eval_impact(G, u, np.array([2.0, 2.0]), 2)
+    check_conditions(G, u, [2.0, 2.0], 2, P)
+    qd_plus = qd + Minv @ W.T @ P
+    alpha = np.arctan(b / h)
+    assert qd_plus[2] / w == pytest.approx(1.0 - 1.5 * np.sin(alpha) ** 2, rel=1e-10)
+    assert modes[1] == OPEN
+
+
+# --- random Delassus matrices against an independent LCP solve --------------------------------
+
+def lcp_matrix(G, u, mu, m):
+    """Stewart & Trinkle's LCP w = A z + q, per point z = (P_n, beta+, beta-, slip speed)."""
+    n = 4 * m
+    A = np.zeros((n, n))
+    q = np.zeros(n)
+    for i, j in itertools.product(range(m), range(m)):
+        gnn, gnt = G[2 * i, 2 * j], G[2 * i, 2 * j + 1]
+        gtn, gtt = G[2 * i + 1, 2 * j], G[2 * i + 1, 2 * j + 1]
+        A[4 * i, 4 * j:4 * j + 3] = [gnn, gnt, -gnt]
+        A[4 * i + 1, 4 * j:4 * j + 3] = [gtn, gtt, -gtt]
+        A[4 * i + 2, 4 * j:4 * j + 3] = [-gtn, -gtt, gtt]
+    for i in range(m):
+        A[4 * i + 1, 4 * i + 3] = A[4 * i + 2, 4 * i + 3] = 1.0
+        A[4 * i + 3, 4 * i:4 * i + 3] = [mu[i], -1.0, -1.0]
+        q[4 * i:4 * i + 3] = [u[2 * i], u[2 * i + 1], -u[2 * i + 1]]
+    return A, q
+
+
+def slow_lcp_solutions(G, u, mu, m):
+    """Every complementary basis with a feasible point (by linprog): the impulses P of each."""
+    A, q = lcp_matrix(G, u, mu, m)
+    n = A.shape[0]
+    out = []
+    for basis in itertools.product((0, 1), repeat=n):
+        z_free = np.array(basis, dtype=bool)          # z_i may be > 0, then w_i = 0
+        if not z_free.any():
+            if np.all(q >= -1e-12 * max(1.0, np.abs(q).max())):
+                out.append(np.zeros(2 * m))
+            continue
+        idx = np.flatnonzero(z_free)
+        A_eq = A[np.ix_(z_free, idx)]
+        b_eq = -q[z_free]
+        A_ub = -A[np.ix_(~z_free, idx)]
+        b_ub = q[~z_free]
+        res = linprog(np.zeros(idx.size), A_ub=A_ub if A_ub.size else None,
+                      b_ub=b_ub if A_ub.size else None, A_eq=A_eq, b_eq=b_eq,
+                      bounds=[(0, None)] * idx.size, method="highs")
+        if res.status == 0:
+            z = np.zeros(n)
+            z[idx] = res.x
+            P = np.zeros(2 * m)
+            for i in range(m):
+                P[2 * i] = z[4 * i]
+                P[2 * i + 1] = z[4 * i + 1] - z[4 * i + 2]
+            out.append(P)
+    return out
+
+
+@st.composite
+def impact_problems(draw):
+    m = draw(st.sampled_from([1, 2]))
+    ndof = draw(st.sampled_from([3, 5]))
+    rows = np.array(draw(st.lists(st.floats(-2, 2), min_size=2 * m * ndof, max_size=2 * m * ndof)))
+    W = rows.reshape(2 * m, ndof)
+    flat = m == 2 and draw(st.booleans())
+    if flat:                                   # a flat double contact: dependent tangential rows
+        W[3] = W[1]
+    if np.linalg.matrix_rank(W[[0, 2]] if m == 2 else W[[0]]) < m:
+        W[0, 0] += 1.0
+        W[-2, -1] += 1.0
+    diag = np.array(draw(st.lists(st.floats(0.2, 5), min_size=ndof, max_size=ndof)))
+    mix = np.array(draw(st.lists(st.floats(-0.3, 0.3), min_size=ndof * ndof,
+                                 max_size=ndof * ndof))).reshape(ndof, ndof)
+    M = np.diag(diag) + mix @ mix.T
+    G = W @ np.linalg.inv(M) @ W.T
+    u = np.array(draw(st.lists(st.floats(-3, 3), min_size=2 * m, max_size=2 * m)))
+    mu = np.array(draw(st.lists(st.floats(0.0, 1.2), min_size=m, max_size=m)))
+    return G, u, mu, m
+
+
+@settings(max_examples=60, deadline=None)
+@given(impact_problems())
+def test_random_delassus_against_slow_lcp(problem):
+    G, u, mu, m = problem
+    source, P, _ = eval_impact(G, u, mu, m)
+    assert source != NOT_FOUND
+    check_conditions(G, u, mu, m, P, tol=1e-6)
+    de = energy_change(G, u, P, m)
+    scale = max(1e-12, float(np.abs(u).max() ** 2 / max(np.abs(np.diag(G)).max(), 1e-12)))
+    assert de <= 1e-9 * scale                                  # kinetic energy never rises
+    slow = slow_lcp_solutions(G, u, mu, m)
+    assert slow, "the slow LCP solve found no solution"
+    slow_de = min(energy_change(G, u, p, m) for p in slow)
+    assert de == pytest.approx(slow_de, abs=1e-6 * scale)      # the most dissipative one
+
+
+@settings(max_examples=40, deadline=None)
+@given(impact_problems())
+def test_lemke_fallback_solves_the_same_lcp(problem):
+    G, u, mu, m = problem
+    lw = np.zeros((ly.N_LAW, ly.N_LAW_COLS))
+    P = np.zeros(2 * m)
+    if lemke_impact(G, u, mu, m, lw, P):
+        check_conditions(G, u, mu, m, P, tol=1e-6)

@@ -1,0 +1,116 @@
+"""Transitions in the model (workbench/core/transitions.py), the slot stop and the axial damping.
+
+MODEL.md §5-§7: the end stop's force is minus the gradient of its potential;
+the axial coordinates are damped at their own mode's zeta; Moreau-Jean steps
+never add kinetic energy and leave no closed point approaching; the
+accumulations, inconsistent regimes and floods of contact-diagnosis.md
+end in finished runs with every impact dissipative.
+"""
+import numpy as np
+import pytest
+
+from workbench import excitation as X
+from workbench import model as mdl
+from workbench.core import layout as ly
+from workbench.core.constrained import kinetic_energy
+from workbench.core.dynamics import cork_energy, cork_force, eval_inertia
+from workbench.core.transitions import moreau_jean_step
+from workbench.modes import linear_eigenvalues
+from workbench.params import ParameterError, Parameters
+from workbench.simulate import CONTACT_STAT_KEYS, simulate
+
+
+@pytest.mark.parametrize("cork", ["none", "linear", "cubic"])
+def test_slot_stop_force_is_minus_the_gradient_of_its_energy(cork):
+    P = mdl.pack(Parameters(cork=cork, cork_c=0.0))
+    for s in (-1.3, -0.9, -0.2, 0.3, 0.8, 1.7):
+        h = 1e-6
+        grad = (cork_energy(s + h, P) - cork_energy(s - h, P)) / (2 * h)
+        assert cork_force(s, 0.0, P) == pytest.approx(grad, rel=1e-7, abs=1e-3)
+    # beyond the travel the stop adds k_stop per cm; inside it adds nothing
+    p = Parameters(cork=cork, cork_c=0.0)
+    unbounded = mdl.pack(p.replace(s_travel=float("inf")))
+    assert cork_force(0.5, 0.0, P) == cork_force(0.5, 0.0, unbounded)
+    extra = cork_force(1.0, 0.0, P) - cork_force(1.0, 0.0, unbounded)
+    assert extra == pytest.approx(p.k_stop * (1.0 - p.s_travel), rel=1e-12)
+
+
+def test_slot_travel_accepts_inf_and_refuses_nonsense():
+    assert Parameters(s_travel=float("inf")).s_travel == float("inf")
+    for bad in (0.0, -1.0, float("nan"), float("-inf")):
+        with pytest.raises(ParameterError, match="s_travel"):
+            Parameters(s_travel=bad)
+
+
+@pytest.mark.parametrize("tip", [True, False])
+def test_axial_coordinates_are_damped_at_their_own_zeta(tip):
+    """c = 2 zeta sqrt(k m) with m = M(0)[u, u]; the axial modes' damping ratios stay near zeta."""
+    p = Parameters(tip_mass=tip)
+    model, work = mdl.build(p), mdl.make_work()
+    zero = np.zeros(ly.N_DOF)
+    eval_inertia(zero, zero, *model, *work)
+    for beam, i in (("a", ly.U_A), ("b", ly.U_B)):
+        assert p.axial_mass(beam) == pytest.approx(work.mat[ly.MAT_M][i, i], rel=1e-12)
+        k = model.kc[ly.KC_K][i, i]
+        assert model.kc[ly.KC_C][i, i] == pytest.approx(2 * (p.zeta_a if beam == "a" else p.zeta_b)
+                                                        * np.sqrt(k * p.axial_mass(beam)))
+    lam = linear_eigenvalues(p)
+    fast = lam[np.abs(lam) > 2 * np.pi * 500.0]          # the axial modes (0.9-5.6 kHz)
+    zeta = -fast.real / np.abs(fast)
+    assert fast.size and np.all(zeta < 0.02) and np.all(zeta > 0.003)
+
+
+def test_moreau_jean_step_is_plastic_and_dissipative():
+    """One step of the fallback from a state whose corner 2 approaches the upper plate."""
+    p = Parameters().replace(gap_mm=1.016)
+    model, work = mdl.build(p), mdl.make_work()
+    y = np.zeros(ly.N_AUG)
+    y[ly.V] = p.gap / 2 - 1e-9                  # corner 2 just touching the upper plate
+    y[ly.N_DOF + ly.V] = 20.0                   # approaching it at 20 cm/s
+    y[ly.N_DOF + ly.S] = 5.0                    # and sliding
+    work.stages[ly.STAGE_CUR] = y
+    work.rg[:] = 0.0
+    st = np.zeros(ly.N_ST)
+    h = 1e-4
+    status = moreau_jean_step(0.0, h, *model, X.none(), work.rec, work.mat, work.vec, work.cg,
+                              work.cw, work.rg, work.stages, st)
+    assert status == ly.OK
+    after = work.stages[ly.STAGE_CUR]
+    # the impulse stopped the approach of corner 2 (plastic) and removed energy
+    assert after[ly.N_DOF + ly.V] <= 1e-9
+    assert st[ly.ST_E_STEPPED] > 0 and st[ly.ST_N_STEPPED] == 1
+    assert int(work.rg[ly.RG_SET]) == 2                  # contact set {2}
+    eval_inertia(after[:ly.N_DOF], after[ly.N_DOF:ly.N_STATE], *model, *work)
+    ke_after = kinetic_energy(after[ly.N_DOF:ly.N_STATE], work.mat)
+    eval_inertia(y[:ly.N_DOF], y[ly.N_DOF:ly.N_STATE], *model, *work)
+    assert ke_after < kinetic_energy(y[ly.N_DOF:ly.N_STATE], work.mat)
+
+
+def hard_run(force_n, freq_hz, duration, **changes):
+    p = Parameters(cork="cubic", tip_mass=True, **changes).replace(gap_mm=1.016)
+    return simulate(p, X.sine(force_n, freq_hz, ramp_s=1.0), duration)
+
+
+@pytest.mark.parametrize("force_n, freq_hz", [(100.0, 45.0), (200.0, 50.0), (200.0, 30.0)])
+def test_the_diagnosed_failures_finish(force_n, freq_hz):
+    """contact-diagnosis.md: accumulations 1 <-> 3, opening 'impacts', the cycling settle, the jam."""
+    run = hard_run(force_n, freq_hz, 3.0)
+    assert run.ok, run.message
+    s = run.summary()
+    for key in CONTACT_STAT_KEYS:
+        assert key in s
+    assert s["n_impacts"] > 100 and s["accumulations"] > 0
+    impacts = run.events[run.events.kind == "impact"]
+    assert (impacts.ke_lost >= -1e-12 * run.signals.e_kin.max()).all()
+    # the slot holds s: within the travel plus what the stop allows under the friction
+    over = max(abs(s["s_min_cm"]), abs(s["s_max_cm"])) - run.params.s_travel
+    assert over < 1.0
+    assert s["max_penetration_cm"] < 1e-6
+
+
+@pytest.mark.parametrize("mu", [0.0, 1.0])
+def test_friction_coefficients_at_the_ends_of_the_range_finish(mu):
+    run = hard_run(200.0, 40.0, 2.0, mu_s=mu, mu_k=mu)
+    assert run.ok, run.message
+    impacts = run.events[run.events.kind == "impact"]
+    assert (impacts.ke_lost >= -1e-12 * run.signals.e_kin.max()).all()
