@@ -47,11 +47,15 @@ def test_falling_across_the_gap_closed_form():
     v_hit = p.g * t_hit
     ke = 0.5 * loose_mass(p) * v_hit ** 2
     assert impacts.ke_lost.iloc[0] == pytest.approx(ke, rel=1e-8)
-    assert impacts.impulse_n1.iloc[0] == pytest.approx(loose_mass(p) * v_hit, rel=1e-8)
+    # with psi held the body lands flat on the plate (1) and the lip (3) at once:
+    # one impact over both points; their rows coincide, so only the sum is determined
+    first = impacts.iloc[0]
+    assert first.impulse_n1 + first.impulse_n3 == pytest.approx(loose_mass(p) * v_hit, rel=1e-8)
+    assert min(first.impulse_n1, first.impulse_n3) >= 0.0
     end = run.signals.iloc[-1]
     assert end.v == pytest.approx(-p.gap / 2, abs=1e-12)
     assert abs(end.v_dot) < 1e-9
-    assert end.lambda_n1 == pytest.approx(loose_mass(p) * p.g, rel=1e-9)   # it rests
+    assert end.lambda_n1 + end.lambda_n3 == pytest.approx(loose_mass(p) * p.g, rel=1e-9)  # it rests
     assert run.stats["max_penetration_cm"] < 1e-8
 
 
@@ -73,7 +77,8 @@ def test_rocking_onto_the_lower_lip_closed_form():
 
 
 def test_stick_slip_against_a_linear_cork_closed_form():
-    p = Parameters().replace(cork="linear", cork_c=0.0, mu_s=0.3, mu_k=0.3)
+    p = Parameters().replace(cork="linear", cork_c=0.0, mu_s=0.3, mu_k=0.3,
+                                 s_travel=float("inf"))   # the linear cork alone
     k = p.cork_law[1]
     m = loose_mass(p)
     friction = p.mu_k * m * p.g
@@ -213,15 +218,18 @@ def test_energy_balance_closes_at_a_fine_step():
 
 
 def test_halving_the_step_reduces_the_error_eightfold():
-    """0.1 s from the paper's start, 17 events (impacts, stick/slip, separations).
+    """0.03 s from the paper's start, 25 events (impacts, stick/slip, separations).
 
     Positions, velocities and the energy balance converge at RK4's order
-    through the events (measured ratios 12-17 per halving).
+    through the events (measured ratios 12-18 per halving).  Later the
+    single contact {4} goes through a stick-slip cycle driven by the
+    lightly damped axial modes (1-2 kHz), where events near the friction
+    limit come and go with the step: the event counts differ from 0.05 s on.
     """
     p = Parameters()
-    runs = {dt: simulate(p, None, 0.1, dt=dt, initial="paper") for dt in (5e-5, 2.5e-5, 1.25e-5)}
+    runs = {dt: simulate(p, None, 0.03, dt=dt, initial="paper") for dt in (5e-5, 2.5e-5, 1.25e-5)}
     n_events = {dt: len(r.events) for dt, r in runs.items()}
-    assert len(set(n_events.values())) == 1 and n_events[5e-5] >= 10     # the same events
+    assert len(set(n_events.values())) == 1 and n_events[5e-5] >= 20     # the same events
     ref = runs[1.25e-5]
     for col in ("w_B", "s", "v", "psi", "w_B_dot", "s_dot", "v_dot", "psi_dot"):
         err = [np.abs(runs[dt].signals[col] - ref.signals[col]).max() for dt in (5e-5, 2.5e-5)]
@@ -230,10 +238,9 @@ def test_halving_the_step_reduces_the_error_eightfold():
     assert bal[0] / bal[1] >= 8.0
     t_err = [np.abs(runs[dt].events.t.to_numpy() - ref.events.t.to_numpy()).max()
              for dt in (5e-5, 2.5e-5)]
-    # event times: within 1e-7 s at the default step, and shrinking; the
-    # slip -> stick times converge irregularly (error terms of opposite sign,
-    # measured against dt/32: -9.5e-9, 3.2e-9, 4.1e-10 s), the others ~16-fold
-    assert t_err[0] < 1e-7 and t_err[1] < t_err[0], t_err
+    # event times converge too (measured 3.7e-5 s at 5e-5 s, 2.3e-6 s at 2.5e-5 s: the
+    # slip -> stick times of the stick-slip cycle driven by the 2 kHz axial mode)
+    assert t_err[0] / t_err[1] >= 8.0 and t_err[1] < 1e-5, t_err
 
 
 def test_every_regime_is_reached():
@@ -246,7 +253,8 @@ def test_every_regime_is_reached():
                    .events.to_regime)
     q0 = np.zeros(18)
     q0[ly.S], q0[ly.V] = 1.0, -p.gap / 2
-    reached |= set(simulate(p.replace(cork="linear", cork_c=0.0), None, 0.3, dt=2e-5, initial=q0,
+    reached |= set(simulate(p.replace(cork="linear", cork_c=0.0, s_travel=float("inf")), None, 0.3,
+                            dt=2e-5, initial=q0,
                             fixed=held_except("s", "v")).events.to_regime)
     # weightless, thrown flat against the upper plate: {2, 4}, sliding and not
     weightless = p.replace(g=0.0, cork="linear")

@@ -3,8 +3,14 @@
 The paper's own method (seed §2.3): an adaptive solver per regime (LSODA,
 rtol 1e-10), terminal events, restarts.  From the paper's start (undeformed, at rest, free
 flight) with the tip mass, 36 ms cover impacts into free flight, into
-sliding single and double contacts, slip -> stick, stick -> slip and a
-separation.
+sliding single and double contacts, a stick-slip cycle of contact {4},
+separations.
+
+The stick-slip cycle is driven by the beams' axial modes (1-2 kHz, damped
+at zeta < 1 %, MODEL.md §5): event by event it needs a step that resolves
+them.  The kernel runs at KERNEL_DT (|lambda| dt = 0.26 for the fastest
+mode); at the default 1e-4 s (|lambda| dt = 2.05, where RK4 damps that
+mode by 0.71 per step) it takes 17 of the reference's 34 events.
 """
 import numpy as np
 import pytest
@@ -17,12 +23,13 @@ from workbench.params import Parameters
 from workbench.simulate import simulate
 
 HORIZON = 0.036
+KERNEL_DT = 1.25e-5
 
 
 @pytest.fixture(scope="module")
 def both():
     p = Parameters()
-    kernel = simulate(p, None, HORIZON, initial="paper")            # the default step
+    kernel = simulate(p, None, HORIZON, dt=KERNEL_DT, initial="paper")
     ref = HybridReference(p)
     run = ref.run(0.0, HORIZON, np.zeros(2 * ly.N_DOF), t_eval=kernel.signals.index.to_numpy())
     return kernel, run.log, run.y, run, ref
@@ -33,12 +40,12 @@ def test_event_times_agree_with_the_reference(both):
     ev = kernel.events[kernel.events.kind != "start"]
     kinds = {e["kind"] for e in ref_log}
     assert {"impact", "separation", "stick-slip", "slip-stick"} <= kinds
-    assert len(ev) == len(ref_log) >= 8
+    assert len(ev) == len(ref_log) >= 30
     for k, r in zip(ev.itertuples(), ref_log):
         assert (k.kind, k.from_regime, k.to_regime, k.point) == \
                (r["kind"], r["from_regime"], r["to_regime"], r["point"])
         assert abs(k.t - r["t"]) < 1e-6, (k, r)
-        assert k.ke_lost == pytest.approx(r["ke_lost"], rel=1e-6, abs=1e-9)
+        assert k.ke_lost == pytest.approx(r["ke_lost"], rel=1e-5, abs=1e-9)
 
 
 def test_end_state_agrees_with_the_reference(both):
@@ -47,9 +54,9 @@ def test_end_state_agrees_with_the_reference(both):
     end = kernel.signals[cols].iloc[-1].to_numpy()
     assert kernel.signals.index[-1] == pytest.approx(HORIZON)
     err = np.abs(end - ref_end)
-    # at the default step: positions to 1e-7 cm (rad), velocities to 1e-5 cm/s
+    # positions to 1e-7 cm (rad), velocities to 5e-5 cm/s (the axial rates)
     assert err[:ly.N_DOF].max() < 1e-7, err
-    assert err[ly.N_DOF:].max() < 1e-5, err
+    assert err[ly.N_DOF:].max() < 5e-5, err
 
 
 def test_sampled_tip_height_agrees_with_the_reference(both):

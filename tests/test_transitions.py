@@ -79,7 +79,8 @@ def test_moreau_jean_step_is_plastic_and_dissipative():
     # the impulse stopped the approach of corner 2 (plastic) and removed energy
     assert after[ly.N_DOF + ly.V] <= 1e-9
     assert st[ly.ST_E_STEPPED] > 0 and st[ly.ST_N_STEPPED] == 1
-    assert int(work.rg[ly.RG_SET]) == 2                  # contact set {2}
+    contact_set = int(work.rg[ly.RG_SET])                # {2}, or {2, 4}: it lies flat
+    assert 1 in (ly.SET_FIRST[contact_set], ly.SET_SECOND[contact_set])
     eval_inertia(after[:ly.N_DOF], after[ly.N_DOF:ly.N_STATE], *model, *work)
     ke_after = kinetic_energy(after[ly.N_DOF:ly.N_STATE], work.mat)
     eval_inertia(y[:ly.N_DOF], y[ly.N_DOF:ly.N_STATE], *model, *work)

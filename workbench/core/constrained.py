@@ -252,40 +252,58 @@ def _bound(c, d, lo, hi, short):
     return lo, min(hi, x), short
 
 
+@nb.njit(**JIT_INLINE)
+def _masked(cg, row, ms, mv, mp):
+    """A geometry row's gradient on the free joint coordinates (s, v, psi)."""
+    return (ms * cg[row, ly.CG_DS], mv * cg[row, ly.CG_DV], mp * cg[row, ly.CG_DPSI])
+
+
 @nb.njit(**JIT)
-def stick_margin(P, cg, rg):
+def stick_margin(P, free, cg, rg):
     """How far a sticking regime is inside the friction cone (dyn): >= 0 while sticking holds.
 
     One point: mu_s lambda_n - |lambda_t|.  Two points (the forces in rg
     solved with the first point's tangential row, cg current): the contact
-    force in (s, v, psi) splits into per-point normal and tangential forces
-    along the null direction d of the four rows (n1, t1, n2, t2), scaled to
-    unit largest entry; sticking holds while some split alpha has
-    lambda_n,k >= 0 and |lambda_t,k| <= mu_s lambda_n,k at both points.  The
-    margin is the width of that interval of alpha (dyn), so that it reaches
-    0 where the per-point slip of MODEL.md §7 takes over.
+    force on the free joint coordinates splits into per-point normal and
+    tangential forces along the null direction d of the four rows (n1, t1,
+    n2, t2), scaled to unit largest entry; sticking holds while some split
+    alpha has lambda_n,k >= 0 and |lambda_t,k| <= mu_s lambda_n,k at both
+    points.  The margin is the width of that interval of alpha (dyn), so
+    that it reaches 0 where the per-point slip of MODEL.md §7 takes over.
+    When the four rows span less than three dimensions (a flat double
+    contact with psi held: the points' rows coincide) the margin is
+    mu_s sum lambda_n - |lambda_t|.
     """
     set_index = int(rg[ly.RG_SET])
     p1 = ly.SET_FIRST[set_index]
     p2 = ly.SET_SECOND[set_index]
     mu = P[ly.P_MU_S]
+    shared = mu * (rg[ly.RG_LN + p1] + (rg[ly.RG_LN + p2] if p2 >= 0 else 0.0)) \
+        - abs(rg[ly.RG_LT])
     if p2 < 0:
-        return mu * rg[ly.RG_LN + p1] - abs(rg[ly.RG_LT])
-    n1 = (cg[ly.CG_G + p1, ly.CG_DS], cg[ly.CG_G + p1, ly.CG_DV], cg[ly.CG_G + p1, ly.CG_DPSI])
-    t1 = (cg[ly.CG_T + p1, ly.CG_DS], cg[ly.CG_T + p1, ly.CG_DV], cg[ly.CG_T + p1, ly.CG_DPSI])
-    n2 = (cg[ly.CG_G + p2, ly.CG_DS], cg[ly.CG_G + p2, ly.CG_DV], cg[ly.CG_G + p2, ly.CG_DPSI])
-    t2 = (cg[ly.CG_T + p2, ly.CG_DS], cg[ly.CG_T + p2, ly.CG_DV], cg[ly.CG_T + p2, ly.CG_DPSI])
+        return shared
+    ms = _free_mask(free, ly.S)
+    mv = _free_mask(free, ly.V)
+    mp = _free_mask(free, ly.PSI)
+    n1 = _masked(cg, ly.CG_G + p1, ms, mv, mp)
+    t1 = _masked(cg, ly.CG_T + p1, ms, mv, mp)
+    n2 = _masked(cg, ly.CG_G + p2, ms, mv, mp)
+    t2 = _masked(cg, ly.CG_T + p2, ms, mv, mp)
     # null vector of the 3 x 4 matrix [n1 t1 n2 t2] by cofactors
     d0 = _det3(t1, n2, t2)
     d1 = -_det3(n1, n2, t2)
     d2 = _det3(n1, t1, t2)
     d3 = -_det3(n1, t1, n2)
     big = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)))
-    if big > 0.0:
-        d0 /= big
-        d1 /= big
-        d2 /= big
-        d3 /= big
+    scale = 1.0
+    for r in (n1, t1, n2, t2):
+        scale = max(scale, abs(r[0]) + abs(r[1]) + abs(r[2]))
+    if big <= 1e-12 * scale ** 3:
+        return shared
+    d0 /= big
+    d1 /= big
+    d2 /= big
+    d3 /= big
     a1 = rg[ly.RG_LN + p1]
     b1 = rg[ly.RG_LT]
     a2 = rg[ly.RG_LN + p2]

@@ -58,7 +58,7 @@ STEPPED_STEPS = 10
 
 
 @nb.njit(**JIT)
-def event_values(y, P, cg, rg, ev, row, rate_row):
+def event_values(y, P, free, cg, rg, ev, row, rate_row):
     """Event functions of the regime in rg at y into ev[row] (gap rates into ev[rate_row]).
 
     The contact forces in rg must be those of y (rhs_regime just ran).
@@ -82,7 +82,7 @@ def event_values(y, P, cg, rg, ev, row, rate_row):
     ev[row, ly.EV_SLIP] = 1.0
     if set_index > 0:
         if stick:
-            ev[row, ly.EV_STICK] = stick_margin(P, cg, rg) + stick_tolerance(P, rg)
+            ev[row, ly.EV_STICK] = stick_margin(P, free, cg, rg) + stick_tolerance(P, rg)
         else:
             rate = row_rate(cg, ly.CG_T + tangent_point(set_index), qd)
             ev[row, ly.EV_SLIP] = rg[ly.RG_SIGN] * rate + RATE_EPS
@@ -111,7 +111,7 @@ def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, sta
         status = rhs_regime(t + theta * h, y_try, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
                             rg, stages[ly.STAGE_KTRY])
     if status == ly.OK:
-        event_values(y_try, P, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
+        event_values(y_try, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
     return status
 
 
@@ -337,7 +337,7 @@ def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, s
         log[n_log, ly.LOG_TO] = reg_to
     else:
         _log(log, n_log, t, kind, reg_from, reg_to, point)
-    event_values(y, P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+    event_values(y, P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
     st[ly.ST_N_EVENTS] += 1.0
     return ly.OK
 
@@ -361,7 +361,7 @@ def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, 
     status = choose_regime(t + h, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec, cg,
                            cw, rg, stages, stages[ly.STAGE_K1], st, GAP_TOL)
     if status == ly.OK:
-        event_values(stages[ly.STAGE_CUR], P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+        event_values(stages[ly.STAGE_CUR], P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
     return status
 
 
@@ -417,7 +417,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                            stages[ly.STAGE_K1], st, GAP_TOL)
     if status != ly.OK:
         return status, stored, n_log
-    event_values(y, P, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+    event_values(y, P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
     if step0 == 0:
         _log(log, n_log, t, ly.KIND_START, reg_start,
              regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
@@ -457,7 +457,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                                         mat, vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
                 if status != ly.OK:
                     return status, stored, n_log
-                event_values(stages[ly.STAGE_NEXT], P, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+                event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
                 status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                                           ev, stages)
                 if status != ly.OK:

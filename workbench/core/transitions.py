@@ -224,7 +224,7 @@ def _gap_acceleration(cg, p, qd, qdd):
 
 
 @nb.njit(**JIT)
-def _violation(y, P, cg, rg, ydot, pts, m, slip_from_rest):
+def _violation(y, P, free, cg, rg, ydot, pts, m, slip_from_rest):
     """How far the regime in rg (forces in rg, q'' in ydot) is from consistent (<= 0: consistent).
 
     Normalised by the scales of the contact forces and the accelerations.
@@ -253,7 +253,7 @@ def _violation(y, P, cg, rg, ydot, pts, m, slip_from_rest):
         worst = max(worst, v)
     if set_index > 0:
         if stick:
-            margin = stick_margin(P, cg, rg)
+            margin = stick_margin(P, free, cg, rg)
             worst = max(worst, -(margin + 0.5 * stick_tolerance(P, rg)) / f_scale)
         elif slip_from_rest:
             g = ly.CG_T + tangent_point(set_index)
@@ -272,7 +272,7 @@ def _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, set_index, stick, s
     for j in range(ly.N_DOF):
         ydot[ly.N_DOF + j] = a0[j]
     add_contact_forces(y, P, free, mat, cg, cw, rg, ydot)
-    return _violation(y, P, cg, rg, ydot, pts, m, slip_from_rest)
+    return _violation(y, P, free, cg, rg, ydot, pts, m, slip_from_rest)
 
 
 @nb.njit(**JIT)

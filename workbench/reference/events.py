@@ -17,8 +17,9 @@ The transition *rules* are those of MODEL.md §7 and the kernel's: the same
 impact law (:func:`workbench.core.impact_law.eval_impact`, on Delassus
 matrices built here from the jets), the same enumeration of regimes in the
 same order with the same tolerances, and the shared tangential row of a
-double contact.  The kernel's small thresholds (GAP_EPS, LAMBDA_EPS, ...)
-shift event times by far less than the 1e-6 s the comparison allows.
+double contact; the event thresholds are the kernel's (GAP_EPS, LAMBDA_EPS,
+the stick margin's round-off band, RATE_EPS), so that the regime chosen
+after an event is the kernel's.
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.linalg import null_space
 
-from ..config import FRICTION_REL_EPS, LAMBDA_EPS
+from ..config import FRICTION_REL_EPS, GAP_EPS, LAMBDA_EPS, RATE_EPS
 from ..core.impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, eval_impact
 from ..core.transitions import CLOSED_RATE, GAP_TOL, REGIME_REL_TOL, REST_RATE
 from .equations import N, Jet, Reference, jcos, jsin
@@ -185,7 +186,9 @@ class HybridReference:
         One point: mu_s lambda_n - |lambda_t|.  Two points: the width of the
         interval of splits alpha (along the unit null vector of the rows n1,
         t1, n2, t2) that keep lambda_n,k >= 0 and |lambda_t,k| <= mu_s
-        lambda_n,k at both points.
+        lambda_n,k at both points.  When the rows on the free joint
+        coordinates span less than three dimensions, mu_s sum lambda_n -
+        |lambda_t|.
         """
         _, lam_n, lam_t = self.solve(t, y, reg)
         mu = self.p.mu_s
@@ -193,7 +196,10 @@ class HybridReference:
             return mu * lam_n.sum() - abs(lam_t)
         k1, k2 = reg.points
         g, tau = self.contact(y[:N], y[N:])
-        rows = np.array([g[k1].g[0], tau[k1].g[0], g[k2].g[0], tau[k2].g[0]])[:, 3:6]
+        joint = [k for k in (3, 4, 5) if k in self.free]
+        rows = np.array([g[k1].g[0], tau[k1].g[0], g[k2].g[0], tau[k2].g[0]])[:, joint]
+        if np.linalg.matrix_rank(rows, tol=1e-9 * np.abs(rows).max()) < 3:
+            return mu * lam_n.sum() - abs(lam_t)              # the points' rows coincide
         d = null_space(rows.T)[:, 0]
         d /= np.abs(d).max()
         x0 = np.array([lam_n[k1], lam_t, lam_n[k2], 0.0])
@@ -212,8 +218,15 @@ class HybridReference:
         _, tau = self.contact(y[:N], y[N:])
         return tau[reg.tangent].d1[0]
 
-    def events(self, reg):
-        """Terminal event functions of a regime (each goes + -> - when it happens)."""
+    def events(self, reg, y):
+        """Terminal event functions of a regime at state y (each goes + -> - when it happens).
+
+        With the kernel's thresholds (workbench/config.py): an impact at g <
+        -GAP_EPS, or below the depth at which a point left if it left
+        closed; a separation at lambda_n < -LAMBDA_EPS; stick -> slip past
+        the round-off band of the margin; slip -> stick at sigma tau' <
+        -RATE_EPS.
+        """
         evs = []
 
         def add(fun, kind, point):
@@ -221,17 +234,23 @@ class HybridReference:
             fun.kind, fun.point = kind, point
             evs.append(fun)
 
+        g0, _ = self.contact(y[:N], y[N:])
         double_stick = reg.stick and len(reg.points) == 2
         for k in range(4):
             if k in reg.points:
                 if not double_stick:         # a sticking pair watches its split in the margin
-                    add(lambda t, y, k=k: self.solve(t, y, reg)[1][k], "separation", k)
+                    add(lambda t, y, k=k: self.solve(t, y, reg)[1][k] + LAMBDA_EPS,
+                        "separation", k)
             else:
-                add(lambda t, y, k=k: self.contact(y[:N], y[N:])[0][k].v[0], "impact", k)
+                arm = GAP_EPS - min(g0[k].v[0], 0.0)
+                add(lambda t, y, k=k, arm=arm: self.contact(y[:N], y[N:])[0][k].v[0] + arm,
+                    "impact", k)
         if reg.set_index and reg.stick:
-            add(lambda t, y: self.margin(t, y, reg), "stick-slip", reg.points[0])
+            add(lambda t, y: self.margin(t, y, reg) + self.stick_tolerance(t, y, reg),
+                "stick-slip", reg.points[0])
         elif reg.set_index:
-            add(lambda t, y: reg.sign * self.slip_rate(y, reg), "slip-stick", reg.points[0])
+            add(lambda t, y: reg.sign * self.slip_rate(y, reg) + RATE_EPS, "slip-stick",
+                reg.points[0])
         return evs
 
     # ---- transitions (MODEL.md §7) -------------------------------------------------
@@ -282,6 +301,11 @@ class HybridReference:
         ke = 0.5 * qd @ M @ qd - 0.5 * qd_plus @ M @ qd_plus
         return np.concatenate([q, qd_plus]), new, ke
 
+    def stick_tolerance(self, t, y, reg):
+        """Round-off band of the stick margin (dyn), as the kernel's."""
+        _, lam_n, _ = self.solve(t, y, reg)
+        return FRICTION_REL_EPS * self.p.mu_s * np.abs(lam_n).sum() + LAMBDA_EPS
+
     def violation(self, t, y, reg, pts, slip_from_rest):
         """How far a regime is from consistent (<= 0: consistent), as the kernel measures it."""
         q, qd = y[:N], y[N:]
@@ -299,7 +323,7 @@ class HybridReference:
             worst = max(worst, -(lam_n[k] + LAMBDA_EPS) / f_scale if k in reg.points
                         else -acc[k] / a_scale)
         if reg.set_index and reg.stick:
-            tol = FRICTION_REL_EPS * self.p.mu_s * np.abs(lam_n).sum() + LAMBDA_EPS
+            tol = self.stick_tolerance(t, y, reg)
             worst = max(worst, -(self.margin(t, y, reg) + 0.5 * tol) / f_scale)
         elif reg.set_index and slip_from_rest:
             T = tau[reg.points[0]]
@@ -404,7 +428,7 @@ class HybridReference:
             times.append(t0)
             samples.append(y.copy())
         while t < t1 and len(log) < max_events:
-            evs = self.events(reg)
+            evs = self.events(reg, y)
             asked = want[want > t]
             sol = solve_ivp(lambda tt, yy, r=reg: self.solve(tt, yy, r)[0], (t, t1), y,
                             method=self.method, rtol=self.rtol, atol=self.atol, events=evs,
