@@ -78,7 +78,7 @@ def test_rocking_onto_the_lower_lip_closed_form():
 
 def test_stick_slip_against_a_linear_cork_closed_form():
     p = Parameters().replace(cork="linear", cork_c=0.0, mu_s=0.3, mu_k=0.3,
-                                 s_travel=float("inf"))   # the linear cork alone
+                             s_travel=float("inf"))       # the linear cork alone
     k = p.cork_law[1]
     m = loose_mass(p)
     friction = p.mu_k * m * p.g
@@ -344,7 +344,9 @@ def test_cli_run_json(capsys):
     assert rc == 0
     for key in ("status", "simulated_s", "wall_s", "n_events", "n_impacts", "regimes_visited",
                 "contact_time_share", "max_penetration_cm", "energy_balance_rel", "strain1_rms",
-                "strain2_rms", "tip_disp_peak_cm"):
+                "strain2_rms", "tip_disp_peak_cm", "accumulations", "inconsistent_resolved",
+                "least_violated", "stepped_steps", "accumulation_energy_lost_erg", "s_min_cm",
+                "s_max_cm"):
         assert key in out
     assert out["simulated_s"] == pytest.approx(0.2)
     assert main(["run", "--gap-mm", "9", "--json"]) == 2

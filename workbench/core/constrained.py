@@ -34,7 +34,7 @@ their rates onto the active rows.
 """
 import numba as nb
 
-from ..config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, RATE_EPS
+from ..config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS
 from . import layout as ly
 from .contact import fill_geometry, row_convective, row_rate, row_to_dof
 from .dynamics import rhs, solve_factored
@@ -180,7 +180,7 @@ def rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
     return ly.OK
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
     """Add the regime's contact forces to the free accelerations in ydot.
 
@@ -258,7 +258,7 @@ def _masked(cg, row, ms, mv, mp):
     return (ms * cg[row, ly.CG_DS], mv * cg[row, ly.CG_DV], mp * cg[row, ly.CG_DPSI])
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def stick_margin(P, free, cg, rg):
     """How far a sticking regime is inside the friction cone (dyn): >= 0 while sticking holds.
 
