@@ -5,18 +5,16 @@ active rows are the normal rows W_n = dg/dq of the set's points and, when
 sticking, the tangential row W_t = dtau/dq of the set's first point:
 
     stick:  M q'' = Q - h + W_n^T lambda_n + W_t^T lambda_t
-    slip:   M q'' = Q - h + sum_k (W_n,k - mu_k sigma W_t)^T lambda_n,k
+    slip:   M q'' = Q - h + sum_k (W_n,k - mu_k sigma W_t,k)^T lambda_n,k
     both:   W q'' + W' q' = 0 for every active row
 
-W_t is the tangential row of one point of the set (:func:`tangent_point`).
-In a double contact the slipping friction, of magnitude mu_k sum lambda_n,
-acts along that same row, where MODEL.md §7 writes one row per point.  The
-deviation is deliberate: with per-point rows the friction force of a
-double contact that starts to slip differs from the sticking force at the
-threshold (the rows' moment arms differ), so neither regime is consistent
-there and the run chatters between them (measured: a flood of stick-slip
-events 0.42 s into a free-flight start).  With the shared row the force is
-continuous at stick -> slip, as in the single contacts.
+Slipping, each point's friction acts along its own tangential row W_t,k.
+Sticking, one tangential row (:func:`tangent_point`) with the normal rows
+locks the joint; in a double contact the split of the contact force between
+the two points is then one free parameter, and the regime sticks while some
+split satisfies both friction cones (:func:`stick_margin`): at the end of
+that interval the sticking force equals the per-point slipping force, so
+stick -> slip is continuous.
 
 With rows A, force directions B (B = A when sticking) and the unconstrained
 accelerations a0 = M^-1 (Q - h):

@@ -99,7 +99,11 @@ def _combo_impulse(G, u, mu, m, modes, lw, P):
                     acc += G[r, c] * E[c, j]
                 A[a, j] = acc
             A[a, k] = -u[r]
-        if not _solve_with_null(A, k, z0, dz, lw[11]):
+        g_max = 0.0
+        for r in range(2 * m):
+            for c in range(2 * m):
+                g_max = max(g_max, abs(G[r, c]))
+        if not _solve_with_null(A, k, z0, dz, lw[11], g_max):
             return False
     # P(alpha) = E (z0 + alpha dz): every condition is c + d alpha >= 0
     u_scale = 0.0
@@ -177,19 +181,21 @@ def _clip(c, d, lo, hi):
 
 
 @nb.njit(**JIT)
-def _solve_with_null(A, k, z0, dz, piv_row):
+def _solve_with_null(A, k, z0, dz, piv_row, g_max):
     """Solve A[:k, :k] z = A[:, k] (in place): a particular z0 and, if rank k - 1, a null dz.
 
-    Gaussian elimination with full pivoting.  Returns False if the rank is
-    below k - 1 or the system is inconsistent.
+    Gaussian elimination with full pivoting; a pivot below LAW_RANK_TOL of
+    the largest entry of A or of the Delassus matrix (g_max) counts as zero
+    (a row with no mobility).  Returns False if the rank is below k - 1 or
+    the system is inconsistent.
     """
     scale = 0.0
     for i in range(k):
         for j in range(k):
             scale = max(scale, abs(A[i, j]))
-    if scale == 0.0:
+    tiny = LAW_RANK_TOL * max(scale, g_max)
+    if scale <= tiny:
         return False
-    tiny = LAW_RANK_TOL * scale
     for j in range(k):
         piv_row[j] = j           # column permutation: position j holds unknown piv_row[j]
     rank = 0

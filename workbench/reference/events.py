@@ -4,7 +4,7 @@ Seed §2.3: integrate one regime with an adaptive solver (LSODA, as the
 paper did, or any other method of scipy's solve_ivp) until a terminal
 event, apply the transition, restart.  Slow, and coded independently of
 the kernels, so that the tests check the kernels against it and the
-benchmarks measure the kernels against it (benchmarks/, issue 6):
+benchmarks measure the kernels against it (benchmarks/):
 
 * gaps and tangential coordinates are the formulas of MODEL.md §7 evaluated
   on the jets of :mod:`workbench.reference.equations` (no hand-derived
@@ -16,8 +16,9 @@ benchmarks measure the kernels against it (benchmarks/, issue 6):
 The transition *rules* are those of MODEL.md §7 and the kernel's: the same
 impact law (:func:`workbench.core.impact_law.eval_impact`, on Delassus
 matrices built here from the jets), the same enumeration of regimes in the
-same order with the same tolerances, and the shared tangential row of a
-double contact; the event thresholds are the kernel's (GAP_EPS, LAMBDA_EPS,
+same order with the same tolerances, per-point friction when slipping and
+the split-feasibility margin of a sticking double contact (computed here
+with numpy); the event thresholds are the kernel's (GAP_EPS, LAMBDA_EPS,
 the stick margin's round-off band, RATE_EPS), so that the regime chosen
 after an event is the kernel's.
 """
