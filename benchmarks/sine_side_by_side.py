@@ -1,0 +1,38 @@
+"""Wall time of the 10 s sine benchmark (1.016 mm, 20 Hz, tip mass, cubic cork) in this checkout.
+
+Run it alternately in two checkouts to compare commits side by side, e.g.
+
+    git worktree add /tmp/old 97d9386
+    for i in 1 2 3; do
+      (cd /tmp/old && PYTHONPATH=/tmp/old python benchmarks/sine_side_by_side.py 20 3)
+      python benchmarks/sine_side_by_side.py 20 3
+    done
+
+Arguments: force (N), runs; ``--locked`` holds the joint (no contact events).
+Prints one JSON line: the wall times (s, simulation only), status, events.
+"""
+import json
+import sys
+
+from workbench import excitation, model
+from workbench.params import Parameters
+from workbench.simulate import simulate
+
+
+def main(argv):
+    force, runs = float(argv[0]), int(argv[1])
+    locked = "--locked" in argv
+    kw = dict(fixed=model.JOINT, initial="paper") if locked else {}
+    p = Parameters(cork="cubic", tip_mass=True).replace(gap_mm=1.016)
+    ex = excitation.sine(force, 20.0, ramp_s=1.0)
+    simulate(p, ex, 0.2, **kw)                      # compile / load the cache
+    walls = []
+    for _ in range(runs):
+        run = simulate(p, ex, 10.0, **kw)
+        walls.append(run.wall_s)
+    print(json.dumps({"force_n": force, "locked": locked, "walls": walls, "status": run.status,
+                      "events": int(len(run.events))}))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
