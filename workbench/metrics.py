@@ -30,6 +30,8 @@ of the tip displacement over the last two windows; ``steady`` is
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .core import layout as ly
@@ -190,8 +192,18 @@ def contact_checks(run) -> dict:
                             over the run's largest kinetic energy (0: none)
     ``stop_overtravel_cm``  how far |s| went past the slot travel (cm)
     ``stop_force_n``        the end stop's largest force k_stop * overtravel (N)
-    ``friction_limit_n``    mu_k times the largest total normal force (N):
-                            the friction the plates can put on the slide
+    ``friction_limit_n``    mu_s times the largest total normal force (N):
+                            the most the plates' friction can push the slide
+    ``slide_speed_cm_s``    the largest |s'| (cm/s)
+    ``stop_allowance_cm``   the overtravel those allow: the stop, a spring
+                            k_stop, meets the slide's mass m (the loose body,
+                            beam B and the tip mass) at speed v while the
+                            friction F pushes on; energy, k d^2 / 2 =
+                            m v^2 / 2 + F d, gives d = F/k + sqrt((F/k)^2 +
+                            m v^2 / k).  The cork's own spring, which pulls
+                            the slide back, is left out (the bound is safe).
+
+    Forces and speeds are read from the stored signals (the output rate).
     """
     from .simulate import CONTACT_STAT_KEYS
     p = run.params
@@ -205,5 +217,14 @@ def contact_checks(run) -> dict:
     out["stop_overtravel_cm"] = over
     out["stop_force_n"] = p.k_stop * over / 1e5
     normal = run.signals[[f"lambda_n{k}" for k in range(1, 5)]].sum(axis=1)
-    out["friction_limit_n"] = float(p.mu_k * normal.max() / 1e5) if len(normal) else 0.0
+    friction = float(p.mu_s * normal.max()) if len(normal) else 0.0
+    out["friction_limit_n"] = friction / 1e5
+    speed = float(run.signals.s_dot.abs().max()) if len(run.signals) else 0.0
+    out["slide_speed_cm_s"] = speed
+    mass = p.m4 + p.mu_b * p.l_b + (p.m6 if p.tip_mass else 0.0)
+    if p.k_stop > 0.0:
+        static = friction / p.k_stop
+        out["stop_allowance_cm"] = static + math.sqrt(static ** 2 + mass * speed ** 2 / p.k_stop)
+    else:
+        out["stop_allowance_cm"] = math.inf
     return out

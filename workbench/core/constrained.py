@@ -27,14 +27,15 @@ held coordinate) gets lambda = 0.  Impacts and the choice of the regime
 are in :mod:`workbench.core.transitions`.
 
 Drift of the active constraints is removed by :func:`project`: a
-least-squares Newton projection of (s, v, psi) onto the active gaps and of
+least-squares Newton projection of (s, v, psi) onto the active gaps (and
+onto any open gap the correction would push past its impact event) and of
 their rates onto the active rows.
 """
 import numba as nb
 
 from ..config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS
 from . import layout as ly
-from .contact import fill_geometry, row_convective, row_rate, row_to_dof
+from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
 from .dynamics import rhs, solve_factored
 
 
@@ -100,7 +101,7 @@ def row_geometry_index(set_index, stick, r):
 
 @nb.njit(**JIT_INLINE)
 def small_solve(cw, m):
-    """Solve D x = c (m <= 3) held in rows CW_D.. of cw; x into column CW_L_COL.
+    """Solve D x = c (m <= MAX_ROWS) held in rows CW_D.. of cw; x into column CW_L_COL.
 
     Gaussian elimination with partial pivoting.  An unknown whose pivot is
     negligible (below 1e-12 of the largest entry: a row that is zero on the
@@ -337,20 +338,40 @@ def _free_mask(free, i):
 
 
 @nb.njit(**JIT_INLINE)
-def _project_rows(y, offset, set_index, stick, rows, P, free, cg, cw):
+def _projection_row(set_index, stick, rows, held, r):
+    """Geometry row of projection row r: the regime's rows, then the held open points."""
+    if r < rows:
+        return row_geometry_index(set_index, stick, r)
+    k = r - rows
+    for p in range(ly.N_POINTS):
+        if held & (1 << p):
+            if k == 0:
+                return ly.CG_G + p
+            k -= 1
+    return -1
+
+
+@nb.njit(**JIT_INLINE)
+def _project_rows(y, offset, set_index, stick, rows, held, P, free, cg, cw):
     """One least-squares correction of y[offset + (S, V, PSI)] by the given rows.
 
-    ``rows`` counts the rows used: the normal rows (1 or 2), plus 1 for the
-    tangential row of a sticking regime.  The residuals are the gap values (offset 0) or
-    the row rates (offset N_DOF).  Returns the largest residual (cm or cm/s).
+    ``rows`` counts the regime's rows used: the normal rows (1 or 2), plus 1
+    for the tangential row of a sticking regime; ``held`` is a bit mask of
+    open points whose gaps are held at zero as well.  The residuals are the
+    gap values (offset 0) or the row rates (offset N_DOF).  Returns the
+    largest residual (cm or cm/s).
     """
     ms = _free_mask(free, ly.S)
     mv = _free_mask(free, ly.V)
     mp = _free_mask(free, ly.PSI)
     qd = y[ly.N_DOF:ly.N_STATE]
+    n = rows
+    for p in range(ly.N_POINTS):
+        if held & (1 << p):
+            n += 1
     worst = 0.0
-    for r in range(rows):
-        g = row_geometry_index(set_index, stick, r)
+    for r in range(n):
+        g = _projection_row(set_index, stick, rows, held, r)
         a = cw[ly.CW_A + r]
         for j in range(ly.N_DOF):
             a[j] = 0.0
@@ -362,15 +383,29 @@ def _project_rows(y, offset, set_index, stick, rows, P, free, cg, cw):
         worst = max(worst, abs(res))
     if worst == 0.0:
         return 0.0
-    for i in range(rows):
-        for j in range(rows):
+    for i in range(n):
+        for j in range(n):
             cw[ly.CW_D + i, j] = _dot9(cw[ly.CW_A + i], cw[ly.CW_A + j])
-    small_solve(cw, rows)
-    for r in range(rows):
+    small_solve(cw, n)
+    for r in range(n):
         mu = cw[ly.CW_D + r, ly.CW_L_COL]
         for j in (ly.S, ly.V, ly.PSI):
             y[offset + j] -= cw[ly.CW_A + r, j] * mu
     return worst
+
+
+@nb.njit(**JIT_INLINE)
+def _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw):
+    """Two Newton steps of the positions onto the active (and held) gaps; geometry refilled.
+
+    Returns the largest |g| of those gaps before the projection (cm).
+    """
+    before = _project_rows(y, 0, set_index, stick, n_normal, held, P, free, cg, cw)
+    if before > 0.0:
+        fill_geometry(y, P, cg)
+        if _project_rows(y, 0, set_index, stick, n_normal, held, P, free, cg, cw) > 0.0:
+            fill_geometry(y, P, cg)
+    return before
 
 
 @nb.njit(**JIT)
@@ -378,25 +413,40 @@ def project(y, P, free, cg, cw, rg):
     """Pull the state onto the active constraints of the regime in rg.
 
     Positions: two Newton steps onto the active gaps g = 0 (the gaps are
-    nearly linear in (s, v, psi) over a step's drift).  Velocities: the
-    active rows' rates (normal, and tangential when sticking) to zero.  Only
-    free joint coordinates move.  Returns the largest |g| found before the
-    projection (cm), the drift.
+    nearly linear in (s, v, psi) over a step's drift).  Moving the joint
+    coordinates moves the open gaps too: an open point that this correction
+    alone would carry past its impact event (g + rg[RG_ARM] from >= 0 to
+    < 0) is held at g = 0 with the active ones, so that a projection never
+    creates a penetration.  Velocities: the active rows' rates (normal, and
+    tangential when sticking) to zero.  Only free joint coordinates move.
+
+    Returns ``(correction, drift)`` (cm): the largest |g| of the active gaps
+    before the projection (the step's truncation error on the constraint)
+    and after it (what the solution keeps).
     """
     set_index = int(rg[ly.RG_SET])
     if set_index == 0:
-        return 0.0
+        return 0.0, 0.0
     n_normal = 1 if ly.SET_SECOND[set_index] < 0 else 2
     fill_geometry(y, P, cg)
     stick = rg[ly.RG_STICK] != 0.0
-    drift = _project_rows(y, 0, set_index, stick, n_normal, P, free, cg, cw)
-    if drift > 0.0:
-        fill_geometry(y, P, cg)
-        if _project_rows(y, 0, set_index, stick, n_normal, P, free, cg, cw) > 0.0:
-            fill_geometry(y, P, cg)
+    armed = 0
+    for p in range(ly.N_POINTS):
+        if not in_set(set_index, p) and cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] >= 0.0:
+            armed |= 1 << p
+    correction = _project_gaps(y, set_index, stick, n_normal, 0, P, free, cg, cw)
+    held = 0
+    for p in range(ly.N_POINTS):
+        if armed & (1 << p) and cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] < 0.0:
+            held |= 1 << p
+    if held != 0:
+        _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw)
+    drift = 0.0
+    for r in range(n_normal):
+        drift = max(drift, abs(cg[row_geometry_index(set_index, stick, r), ly.CG_VAL]))
     rows = n_normal + (1 if stick else 0)
-    _project_rows(y, ly.N_DOF, set_index, stick, rows, P, free, cg, cw)
-    return drift
+    _project_rows(y, ly.N_DOF, set_index, stick, rows, 0, P, free, cg, cw)
+    return correction, drift
 
 
 @nb.njit(**JIT_INLINE)

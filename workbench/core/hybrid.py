@@ -233,6 +233,15 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
 
 
 @nb.njit(**JIT_INLINE)
+def _penetration(st, depth, t, where):
+    """Keep the largest penetration depth (cm), its time and where it was found."""
+    if depth > st[ly.ST_MAX_PEN]:
+        st[ly.ST_MAX_PEN] = depth
+        st[ly.ST_T_MAX_PEN] = t
+        st[ly.ST_PEN_WHERE] = where
+
+
+@nb.njit(**JIT_INLINE)
 def _log(log, n_log, t, kind, reg_from, reg_to, point):
     """Start a log row (impulses and energy zero); returns the row index."""
     r = log[n_log]
@@ -451,7 +460,8 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                 status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                                   stages, stages[ly.STAGE_NEXT])
                 if status == ly.OK:
-                    drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
+                    correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
+                    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
                     st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
                     status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec,
                                         mat, vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
@@ -474,8 +484,8 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                 t = t_end if theta >= 1.0 else t + theta * h
                 for p in range(ly.N_POINTS):       # penetration when the event is found
                     if not in_set(int(rg[ly.RG_SET]), p):
-                        st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN],
-                                                rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p])
+                        _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t,
+                                     10 + p)
             while e >= 0:
                 n_step_events += 1
                 if n_step_events > MAX_EVENTS_PER_STEP:
@@ -500,8 +510,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                 e = _immediate_impact(ev)
         for p in range(ly.N_POINTS):
             if not in_set(int(rg[ly.RG_SET]), p):
-                st[ly.ST_MAX_PEN] = max(st[ly.ST_MAX_PEN],
-                                        rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p])
+                _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p], t, 20 + p)
         st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
         st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
         st[ly.ST_T] = t

@@ -267,7 +267,7 @@ N_LOG = LOG_DKE + 1
 
 # Run statistics st (N_ST,)
 ST_MAX_PEN = 0       # largest penetration -g of an open gap at an accepted state (cm)
-ST_MAX_DRIFT = 1     # largest |g| of an active gap before its projection (cm)
+ST_MAX_DRIFT = 1     # largest |g| of an active gap after its projection (cm)
 ST_N_EVENTS = 2
 ST_N_IMPACTS = 3
 ST_E_IMPACT = 4      # kinetic energy lost in impacts (erg)
@@ -283,7 +283,10 @@ ST_E_STEPPED = 13    # kinetic energy its impulses removed (erg; also in ST_E_IM
 ST_S_MIN = 14        # smallest slide s at an accepted step (cm)
 ST_S_MAX = 15        # largest slide s (cm)
 ST_T_IMPACT = 16     # time of the last impact (s)
-N_ST = 17
+ST_MAX_CORRECTION = 17   # largest |g| of an active gap before its projection (cm)
+ST_T_MAX_PEN = 18    # time of the largest penetration (s)
+ST_PEN_WHERE = 19    # where it was found: 10 x (1 event bracket, 2 step end) + point (0..3)
+N_ST = 20
 
 # Signals stored at the output rate (out_sig columns), CGS units.
 SIGNALS = ("force1", "hammer", "strain1", "strain2", "accel1", "accel2", "accel3", "tip_y",
