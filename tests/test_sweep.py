@@ -14,6 +14,7 @@ from workbench import study as S
 from workbench import sweep as W
 from workbench.report import make_report
 from workbench.params import ParameterError
+from workbench.store import read_runs
 
 SMALL = """
 [study]
@@ -131,10 +132,16 @@ def test_a_failing_point_is_recorded_and_the_sweep_goes_on(small_run, tmp_path, 
     assert (tables / "response.md").read_text().count("failed") == 4 + 1   # 4 blocks + legend
 
 
-def test_an_unstable_point_is_recorded_as_failed(tmp_path):
-    text = SMALL.replace("window_s = 0.2", "window_s = 0.2\ndt = 1e-3\noutput_hz = 1000.0")
-    text = text.replace("gap_mm = [0.508, 1.016]", "gap_mm = [1.016]").replace(
+def test_an_unstable_point_is_recorded_as_failed(tmp_path, monkeypatch):
+    """A run that ends with a failure status (here: a step far beyond RK4's stability, which
+    a study cannot ask for, forced through the API) is a recorded point, with its figures."""
+    text = SMALL.replace("gap_mm = [0.508, 1.016]", "gap_mm = [1.016]").replace(
         "freq_hz = [20.0, 30.0]", "freq_hz = [20.0]")
+    with pytest.raises(ParameterError, match="stability limit"):
+        S.load(write(tmp_path, text.replace("window_s = 0.2", "window_s = 0.2\ndt = 1e-3"),
+                     "unstable.toml"))
+    real = W.simulate
+    monkeypatch.setattr(W, "simulate", lambda p, ex, *a, **kw: real(p, ex, *a, **{**kw, "dt": 1e-3}))
     table = W.run_study(S.load(write(tmp_path, text)), tmp_path / "res", jobs=1, progress=False)
     assert table.status.tolist() == ["failed"]
     assert table.message.iloc[0]
@@ -169,6 +176,16 @@ def test_stepped_sweep_carries_the_state(tmp_path):
     (("window_s = 0.2", 'window_s = 0.2\nsweep = "sideways"'), "sweep = 'sideways'"),
     (("ramp_s = 0.1", "ramp_s = -1.0"), "ramp_s"),
     (("freq_hz = [20.0, 30.0]", "freq_hz = [20.0, 20.0]"), "lists a value twice"),
+    (("freq_hz = [20.0, 30.0]", "freq_hz = [20, 20.0]"), "lists a value twice"),
+    (("freq_hz = [20.0, 30.0]", "freq_hz = [20.0, 1e5]"), "freq_hz = 100000 Hz is above"),
+    (("ramp_s = 0.1", "ramp_s = 3.0"), "soft start would end after the run"),
+    (("window_s = 0.2", "window_s = 0.2\ndt = nan"), "[study] dt = nan"),
+    (("window_s = 0.2", "window_s = 0.2\noutput_hz = 333.0"), "output_hz = 333.0 Hz"),
+    (("[axes]", "[axes]\ncork = [[\"linear\"]]"), "[axes] cork"),
+    (("[excitation]", "[fixed]\ncork = {n = 1}\n[excitation]"), "[fixed] cork"),
+    (('name = "small"', 'name = "' + "x" * 300 + '"'), "at most 100"),
+    (("save_series = [{gap_mm = 1.016, freq_hz = 20.0}]", "save_series = 3"), "save_series"),
+    (("[study]", "study = 3\n[other]"), "unknown table"),
     (("[axes]", "[fixed]\ngap_mm = 1.0\n[axes]"), "both as an axis and as a fixed value"),
 ])
 def test_bad_study_files_are_rejected_before_running(tmp_path, edit, message):
@@ -257,3 +274,93 @@ gap_mm = [1.016]
     assert not (out / "figures" / "frf_map_tip.png").exists()     # no gap x frequency grid
     long = pd.read_csv(out / "tables" / "response.csv")
     assert long.tip_rms.iloc[0] == pytest.approx(table.tip_rms.iloc[0], rel=1e-12)
+
+
+def test_a_damaged_point_file_is_set_aside_and_recomputed(small_run, tmp_path, capsys):
+    study, root, table = small_run
+    res = tmp_path / "res"
+    W.run_study(study, res, jobs=1, progress=False)
+    files = sorted((res / "small" / "points").glob("*.parquet"))
+    files[0].write_bytes(b"PAR1 not really parquet")
+    (res / "small" / "runs.json").write_text("{ damaged")
+    again = W.run_study(study, res, jobs=1, progress=False)
+    pd.testing.assert_frame_equal(comparable(again), comparable(table), check_exact=True)
+    damaged = sorted(p.name for p in (res / "small" / "damaged").iterdir())
+    assert any(n.startswith(files[0].name) for n in damaged)
+    assert any(n.startswith("runs.json") for n in damaged)
+    err = capsys.readouterr().err
+    assert files[0].name in err and "computed again" in err
+    runs = read_runs(res / "small")
+    assert runs[-1]["state"] == "done" and runs[-1]["points_run"] == 1
+
+
+def test_an_interrupted_sweep_is_on_record(small_run, tmp_path, monkeypatch):
+    study, _, _ = small_run
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(W, "_execute", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        W.run_study(study, tmp_path / "res", jobs=1, progress=False)
+    runs = read_runs(tmp_path / "res" / "small")
+    assert [r["state"] for r in runs] == ["interrupted"] and runs[0]["points_run"] == 4
+
+
+def test_a_second_sweep_of_the_same_study_is_refused(small_run, tmp_path):
+    from workbench.store import StudyLock
+    study, _, _ = small_run
+    out = tmp_path / "res" / "small"
+    with StudyLock(out):
+        with pytest.raises(ParameterError, match="another sweep of this study is running"):
+            W.run_study(study, tmp_path / "res", jobs=1, progress=False)
+    W.run_study(study, tmp_path / "res", jobs=1, progress=False)      # free again
+
+
+def _children(pid):
+    kids = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            kids.append(int(stat.parent.name))
+    return kids
+
+
+def _alive(pid):
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_kill_9_of_the_sweep_leaves_no_worker_computing(tmp_path):
+    text = SMALL.replace("duration_s = 0.5", "duration_s = 30.0")
+    path = write(tmp_path, text)
+    cmd = [sys.executable, "-m", "workbench", "sweep", str(path), "--jobs", "2",
+           "--results", str(tmp_path / "res"), "--quiet", "--no-report"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.time() + 300
+        workers = []
+        while time.time() < deadline and len(workers) < 2:
+            workers = [k for k in _children(proc.pid)
+                       if b"loky" in Path(f"/proc/{k}/cmdline").read_bytes()
+                       or b"joblib" in Path(f"/proc/{k}/cmdline").read_bytes()]
+            time.sleep(0.2)
+        assert workers, "the sweep started no worker processes"
+        time.sleep(2.0)                                   # the workers are computing
+        os.kill(proc.pid, signal.SIGKILL)                 # the sweep only, not its group
+        proc.wait()
+        deadline = time.time() + 10 * W.WATCHDOG_S + 5
+        while time.time() < deadline and any(_alive(w) for w in workers):
+            time.sleep(0.2)
+        assert not any(_alive(w) for w in workers), "workers computed on after the sweep died"
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass

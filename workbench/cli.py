@@ -11,16 +11,85 @@
 
 Every subcommand accepts ``--params FILE.toml`` and ``--set NAME=VALUE``
 (repeatable; unit-suffixed names such as ``gap_mm`` are converted).
+
+Exit codes (:data:`EXIT_CODES`): 0 done; 1 a simulation ended with a
+failure status (what it computed is still written); 2 bad input, refused
+before any work, in one line naming the option or key as written; 3 a sweep
+ran but some points failed; 70 an internal error (a bug of ours: one line,
+the traceback in a file named there); 130 interrupted.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import sys
+import time
+import traceback
 from pathlib import Path
 
 from . import __version__
 from .params import CORK_MODELS, ParameterError, Parameters, describe
+from .paths import check_output_dir, check_output_file
+from .limits import (FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N,
+                     MAX_OUTPUT_HZ, MIN_DT)
+
+EXIT_OK = 0
+EXIT_RUN_FAILED = 1
+EXIT_BAD_INPUT = 2
+#: Exit status of ``workbench sweep`` when the sweep ran but some points failed.
+EXIT_POINTS_FAILED = 3
+EXIT_INTERNAL = 70          # sysexits.h EX_SOFTWARE
+EXIT_INTERRUPTED = 130
+EXIT_CODES = {EXIT_OK: "done", EXIT_RUN_FAILED: "a simulation ended with a failure status",
+              EXIT_BAD_INPUT: "bad input, refused before any work",
+              EXIT_POINTS_FAILED: "a sweep ran but some points failed",
+              EXIT_INTERNAL: "internal error (traceback written to a file)",
+              EXIT_INTERRUPTED: "interrupted"}
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors raised (not printed with the usage and exited)."""
+
+    def error(self, message):
+        raise ParameterError(f"{self.prog}: {message}")
+
+
+def _number(lo=None, hi=None, lo_open=False, hi_open=False, integer=False):
+    """An argparse type: a finite number in the range given (the message names the range)."""
+    left = "(" if lo_open or lo is None else "["
+    right = ")" if hi_open or hi is None else "]"
+    allowed = f"{left}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}{right}"
+
+    def parse(text: str):
+        try:
+            value = int(text) if integer else float(text)
+        except ValueError:
+            kind = "an integer" if integer else "a number"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
+        if not integer and not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text!r} must be finite, in {allowed}")
+        below = lo is not None and (value <= lo if lo_open else value < lo)
+        above = hi is not None and (value >= hi if hi_open else value > hi)
+        if below or above:
+            raise argparse.ArgumentTypeError(f"{text} is outside the allowed range {allowed}")
+        return value
+    parse.__name__ = "integer" if integer else "number"
+    return parse
+
+
+def _cut(text: str, n: int = 24) -> str:
+    """``text`` cut to n characters for a message."""
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
+def _given(option: str, call, *args, **kwargs):
+    """call(*args, **kwargs), a ParameterError prefixed with the option as the user wrote it."""
+    try:
+        return call(*args, **kwargs)
+    except ParameterError as exc:
+        raise ParameterError(f"{option}: {exc}") from None
 
 
 def _on_off(text: str) -> bool:
@@ -58,13 +127,56 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _parameters(args) -> Parameters:
-    p = Parameters.from_toml(args.params) if args.params else Parameters()
-    changes = {name: _value(text) for name, text in _pairs(args.set, "--set").items()}
+    """The model of --params, --set and the model options (--tip-mass, --cork, --gap-mm, --mu).
+
+    Each value is checked alone first, so that the message names the option
+    the user wrote; a parameter given twice (``--set cork=linear --cork
+    none``) is refused.
+    """
+    from .params import resolve_name
+    base = _given(f"--params {args.params}", Parameters.from_toml, args.params) \
+        if args.params else Parameters()
+    given = [(f"--set {_cut(name)}={_cut(text)}", name, _value(text))
+             for name, text in _pairs(args.set, "--set").items()]
     if args.tip_mass is not None:
-        changes["tip_mass"] = args.tip_mass
+        given.append((f"--tip-mass {'on' if args.tip_mass else 'off'}", "tip_mass", args.tip_mass))
     if args.cork is not None:
-        changes["cork"] = args.cork
-    return p.replace(**changes) if changes else p
+        given.append((f"--cork {args.cork}", "cork", args.cork))
+    if getattr(args, "gap_mm", None) is not None:
+        given.append((f"--gap-mm {args.gap_mm:g}", "gap_mm", args.gap_mm))
+    if getattr(args, "mu", None) is not None:
+        given += [(f"--mu {args.mu:g}", "mu_s", args.mu), (f"--mu {args.mu:g}", "mu_k", args.mu)]
+    seen: dict[str, str] = {}
+    for label, name, value in given:
+        field = _given(label, resolve_name, name)[0]
+        if field in seen and seen[field] != label:
+            raise ParameterError(f"{label} conflicts with {seen[field]}: give {field} once")
+        seen[field] = label
+    changes = {name: value for _, name, value in given}
+    if not changes:
+        return base
+
+    def build(values):
+        p = base.replace(**values)
+        check_model(p)
+        return p
+    try:
+        return build(changes)
+    except ParameterError as exc:
+        culprits = []
+        for label, name, value in given:
+            try:
+                build({name: value})
+            except ParameterError:
+                culprits.append(label)
+        labels = list(dict.fromkeys(culprits or [label for label, _, _ in given]))
+        raise ParameterError(f"{' '.join(labels)}: {exc}") from None
+
+
+def check_model(p: Parameters) -> None:
+    """The linear model of p is usable (finite, positive definite, conditioned), or ParameterError."""
+    from .modes import linear_eigenvalues
+    linear_eigenvalues(p)
 
 
 def _cmd_modes(args) -> int:
@@ -72,7 +184,7 @@ def _cmd_modes(args) -> int:
     p = _parameters(args)
     freqs = natural_frequencies(p, args.joint)
     if args.json:
-        print(json.dumps({"frequencies_hz": [float(f) for f in freqs], "joint": args.joint,
+        print(json_text({"frequencies_hz": [float(f) for f in freqs], "joint": args.joint,
                           "tip_mass": p.tip_mass, "cork": p.cork}))
     else:
         print(f"Natural frequencies, joint {args.joint}, tip mass {'on' if p.tip_mass else 'off'}, "
@@ -83,16 +195,24 @@ def _cmd_modes(args) -> int:
 
 
 def _chirp(text: str) -> tuple[float, float, float]:
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(f"expects F0:F1:T (Hz:Hz:s), got {text!r}")
+    positive = _number(0, lo_open=True)
     try:
-        f0, f1, sweep = (float(x) for x in text.split(":"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--chirp expects F0:F1:T (Hz:Hz:s), got {text!r}") from None
-    return f0, f1, sweep
+        return tuple(positive(x) for x in parts)
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: {exc} (F0:F1:T, each > 0)") from None
 
 
 def _excitation(args):
     from . import excitation as X
     force = X.DEFAULT_FORCE_N if args.force_n is None else args.force_n
+    if args.force_n is not None and args.force_n < 0 and args.impulse is None:
+        raise ParameterError(f"--force-n {args.force_n:g}: a shaker amplitude must be >= 0 N "
+                             "(a hammer's sign gives its direction)")
+    if args.free_decay is not None and args.force_n is not None:
+        raise ParameterError("--force-n does not apply to --free-decay (a release without drive)")
     if args.freq_hz is not None:
         return X.sine(force, args.freq_hz, ramp_s=args.ramp_s)
     if args.chirp is not None:
@@ -104,30 +224,42 @@ def _excitation(args):
     return None
 
 
+#: The run options behind the names of :func:`workbench.simulate.check_settings`.
+RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--output-hz",
+                    "freq_hz": "--freq-hz", "f0_hz": "--chirp F0", "f1_hz": "--chirp F1",
+                    "width_s": "--pulse-s", "t_hit_s": "--hit-s", "ramp_s": "--ramp-s"}
+
+
 def _cmd_run(args) -> int:
-    from .simulate import simulate
-    p = _parameters(args)
-    changes = {}
-    if args.gap_mm is not None:
-        changes["gap_mm"] = args.gap_mm
-    if args.mu is not None:
-        changes["mu_s"] = changes["mu_k"] = args.mu
-    p = p.replace(**changes) if changes else p
+    from .simulate import check_settings, simulate
     n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse))
     if n_drives > 1:
         raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse")
-    run = simulate(p, _excitation(args), args.duration, dt=args.dt, output_hz=args.output_hz,
+    p = _parameters(args)
+    if args.ramp_s is None and (args.freq_hz is not None or args.chirp is not None):
+        args.ramp_s = min(DEFAULT_RAMP_S, 0.5 * args.duration)
+    ex = _excitation(args)
+    check_settings(p, ex if ex is not None else _excitation_none(), args.duration,
+                   args.dt, args.output_hz, names=RUN_OPTION_NAMES)
+    if args.out:
+        check_output_file("--out", args.out, (".parquet",))
+    run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
                    initial=args.initial, free_decay_cm=args.free_decay,
                    progress=not args.json and sys.stderr.isatty())
     if args.out:
         run.to_parquet(args.out)
     summary = run.summary()
     if args.json:
-        print(json.dumps(summary))
+        print(json_text(summary))
     else:
         for key, value in summary.items():
             print(f"{key:>24}: {value}")
-    return 0 if run.ok else 1
+    return EXIT_OK if run.ok else EXIT_RUN_FAILED
+
+
+def _excitation_none():
+    from .excitation import none
+    return none()
 
 
 def _cmd_params(args) -> int:
@@ -136,7 +268,8 @@ def _cmd_params(args) -> int:
     for row in rows:
         row["value"] = getattr(p, row["name"])
     if args.json:
-        print(json.dumps(rows, default=str, indent=1))
+        print(json.dumps([{k: (str(v) if isinstance(v, float) and not math.isfinite(v) else v)
+                          for k, v in row.items()} for row in rows], default=str, indent=1))
         return 0
     print(f"{'name':<11} {'value':>12} {'unit':<18} {'allowed':<16} source")
     for r in rows:
@@ -149,11 +282,15 @@ def _cmd_params(args) -> int:
 
 def _cmd_sweep(args) -> int:
     from .study import load
-    from .sweep import run_study
+    from .sweep import plan, run_study
 
     study = load(args.study)
-    if args.jobs < 1:
-        raise ParameterError(f"--jobs = {args.jobs} must be at least 1")
+    check_output_dir("--results", args.results)
+    if args.scheduler is not None:
+        _check_scheduler(args.scheduler)
+    if args.dry_run:
+        print(json_text(plan(study, args.results, fresh=args.fresh, jobs=args.jobs)))
+        return EXIT_OK
     table = run_study(study, args.results, jobs=args.jobs, scheduler=args.scheduler,
                       fresh=args.fresh, progress=not args.quiet)
     counts = table.status.value_counts().to_dict() if len(table) else {}
@@ -163,36 +300,59 @@ def _cmd_sweep(args) -> int:
     if not args.no_report:
         from .report import make_report
         summary["report"] = str(make_report(study, args.results))
-    print(json.dumps(summary))
-    return 0 if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
+    print(json_text(summary))
+    return EXIT_OK if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
 
 
-#: Exit status of ``workbench sweep`` when the sweep ran but some points failed.
-EXIT_POINTS_FAILED = 3
+def _check_scheduler(address: str) -> None:
+    """A Dask scheduler address tcp://HOST:PORT (or HOST:PORT) that accepts a connection."""
+    import socket
+    from urllib.parse import urlsplit
+    text = address if "://" in address else f"tcp://{address}"
+    try:
+        url = urlsplit(text)
+        host, port = url.hostname, url.port
+    except ValueError:
+        host, port = None, None
+    if url.scheme not in ("tcp", "tls") or not host or not port:
+        raise ParameterError(f"--scheduler {address}: expects a Dask scheduler address "
+                             "tcp://HOST:PORT")
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except OSError as exc:
+        raise ParameterError(f"--scheduler {address}: no scheduler answers there "
+                             f"({exc.strerror or exc}); start one with `dask scheduler`") from None
 
 
 def _cmd_report(args) -> int:
     from .report import make_report
     from .study import load
 
-    print(make_report(load(args.study), args.results))
-    return 0
+    study = load(args.study)
+    if not (Path(args.results) / study.name / "points.parquet").is_file():
+        raise ParameterError(f"report {args.study}: no results in {Path(args.results) / study.name}"
+                             f"; run `workbench sweep {args.study} --results {args.results}` first")
+    print(make_report(study, args.results))
+    return EXIT_OK
 
 
-def _add_drive_options(parser, ramp_default=None) -> None:
+#: The soft start of ``workbench run`` (s), or half the run if that is shorter.
+DEFAULT_RAMP_S = 1.0
+
+
+def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") -> None:
     drive = parser.add_argument_group("excitation (one; default none)")
-    drive.add_argument("--freq-hz", type=float, help="sine at force1, frequency (Hz)")
+    drive.add_argument("--freq-hz", type=_number(0, lo_open=True), help="sine at force1, frequency (Hz)")
     drive.add_argument("--chirp", type=_chirp, metavar="F0:F1:T", help="linear chirp F0 -> F1 Hz over T s")
-    drive.add_argument("--free-decay", type=float, metavar="CM",
+    drive.add_argument("--free-decay", type=_number(-FREE_DECAY_MAX_CM, FREE_DECAY_MAX_CM), metavar="CM",
                        help="release from a static tip deflection (cm, + up)")
     drive.add_argument("--impulse", choices=("joint", "tip"),
                        help="half-sine hammer: vertical at the joint body, or axial at the tip")
-    drive.add_argument("--force-n", type=float,
+    drive.add_argument("--force-n", type=_number(-MAX_FORCE_N, MAX_FORCE_N),
                        help="shaker amplitude or hammer peak (N); default: see README")
-    drive.add_argument("--ramp-s", type=float, default=ramp_default,
-                       help="soft-start ramp of sine/chirp (s)")
-    drive.add_argument("--pulse-s", type=float, default=1e-3, help="hammer pulse duration (s)")
-    drive.add_argument("--hit-s", type=float, default=0.01, help="hammer pulse start (s)")
+    drive.add_argument("--ramp-s", type=_number(0), help=ramp_help)
+    drive.add_argument("--pulse-s", type=_number(0, lo_open=True), default=1e-3, help="hammer pulse duration (s)")
+    drive.add_argument("--hit-s", type=_number(0), default=0.01, help="hammer pulse start (s)")
 
 
 def _record_settings(args, meta: dict) -> dict:
@@ -225,15 +385,27 @@ def _record_settings(args, meta: dict) -> dict:
     return settings
 
 
+def _pair_numbers(items, option, what, lo=None, lo_open=False) -> dict[str, float]:
+    """Repeated ``--option NAME=NUMBER`` as {name: number}; a bad number names the item."""
+    parse = _number(lo, lo_open=lo_open)
+    out = {}
+    for name, text in _pairs(items, option, what).items():
+        try:
+            out[name] = parse(text)
+        except argparse.ArgumentTypeError as exc:
+            raise ParameterError(f"{option} {_cut(name)}={_cut(text)}: {exc}") from None
+    return out
+
+
 def _read_record(args, path):
     from .expfiles import read
-    scale = _pairs(args.strain_scale, "--strain-scale", "STRAIN_PER_VOLT")
-    return read(path, strain_scale={name.lower(): float(text) for name, text in scale.items()})
+    scale = _pair_numbers(args.strain_scale, "--strain-scale", "STRAIN_PER_VOLT", 0, lo_open=True)
+    return read(path, strain_scale={name.lower(): value for name, value in scale.items()})
 
 
 def _add_joint_options(parser) -> None:
-    parser.add_argument("--gap-mm", type=float, help="total transverse clearance (mm)")
-    parser.add_argument("--mu", type=float, help="friction coefficient (sets mu_s = mu_k)")
+    parser.add_argument("--gap-mm", type=_number(0, lo_open=True), help="total transverse clearance (mm)")
+    parser.add_argument("--mu", type=_number(0, 5), help="friction coefficient (sets mu_s = mu_k)")
 
 
 def _add_record_options(parser) -> None:
@@ -242,23 +414,37 @@ def _add_record_options(parser) -> None:
     _add_drive_options(parser)
     parser.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
                         help="scale factor of a strain channel recorded in V (strain per volt)")
-    parser.add_argument("--skip-s", type=float, default=0.0,
+    parser.add_argument("--skip-s", type=_number(0), default=0.0,
                         help="leave out the first seconds (the transient)")
+
+
+def _check_window(path, record, skip_s: float) -> None:
+    """--skip-s leaves at least two samples of the record."""
+    t = record.index.to_numpy()
+    if len(t) < 2 or t[-1] - t[0] <= skip_s:
+        raise ParameterError(f"--skip-s {skip_s:g}: {path} lasts {t[-1] - t[0]:g} s; leave "
+                             "less out than that")
 
 
 def _cmd_compare(args) -> int:
     from .compare import compare
     from .matching import setup_from
 
+    from .compare import SIGNALS
     record = _read_record(args, args.file)
-    base = Parameters.from_toml(args.params) if args.params else None
+    _check_window(args.file, record, args.skip_s)
+    if not any(c in record.columns for c in SIGNALS):
+        raise ParameterError(f"{args.file}: no signal channel to compare (has "
+                             f"{list(record.columns)}; signals: {list(SIGNALS)})")
+    out = check_output_dir("--out", args.out or Path("results") / "compare" / Path(args.file).stem)
+    base = _given(f"--params {args.params}", Parameters.from_toml, args.params) \
+        if args.params else None
     setup = setup_from(_record_settings(args, record.attrs["meta"]), record, base)
     run = setup.simulate()
-    out = Path(args.out or Path("results") / "compare" / Path(args.file).stem)
     title = f"{Path(args.file).name} vs simulation ({setup.excitation['kind']})"
     result = compare(record, run, out, skip_s=args.skip_s, threshold=args.threshold,
                      chirp=setup.excitation["kind"] == "chirp", title=title)
-    print(json.dumps({"record": args.file, "simulation_status": run.status, "out": str(out),
+    print(json_text({"record": args.file, "simulation_status": run.status, "out": str(out),
                       "figures": [str(p) for p in result.figures if p.suffix == ".png"],
                       "rms_error_rel": dict(zip(result.signals.channel,
                                                 result.signals.rms_error_rel.round(4)))}))
@@ -269,18 +455,26 @@ def _cmd_estimate(args) -> int:
     from .estimate import estimate
     from .matching import setup_from
 
-    start = {name: float(text) for name, text in _pairs(args.fit, "--fit", "START").items()}
-    base = Parameters.from_toml(args.params) if args.params else None
+    from .estimate import FITTABLE
+    start = _pair_numbers(args.fit, "--fit", "START", 0, lo_open=True)
+    unknown = sorted(set(start) - set(FITTABLE))
+    if unknown:
+        raise ParameterError(f"--fit {', '.join(_cut(u) for u in unknown)}: not fittable; "
+                             f"fittable are {', '.join(FITTABLE)}")
+    if args.out:
+        check_output_file("--out", args.out, (".csv",))
+    base = _given(f"--params {args.params}", Parameters.from_toml, args.params) \
+        if args.params else None
     pairs = []
     for path in args.files:
         record = _read_record(args, path)
+        _check_window(path, record, args.skip_s)
         pairs.append((record, setup_from(_record_settings(args, record.attrs["meta"]), record, base)))
     fit = estimate(pairs, start, skip_s=args.skip_s, jobs=args.jobs, max_nfev=args.max_nfev)
     table = fit.table()
     if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         table.to_csv(args.out, index=False)
-    print(json.dumps({"values": fit.values, "intervals_2sigma": fit.intervals, "cost": fit.cost,
+    print(json_text({"values": fit.values, "intervals_2sigma": fit.intervals, "cost": fit.cost,
                       "simulations": fit.n_simulations, "success": fit.success,
                       "message": fit.message, "wall_s": round(fit.wall_s, 1)}))
     return 0 if fit.success else 1
@@ -289,10 +483,11 @@ def _cmd_estimate(args) -> int:
 def _cmd_identify_tables(args) -> int:
     from .identify import tables
 
+    check_output_dir("--out", args.out)
     built = tables.build(include_table6=not args.no_table6)
     paths = tables.write(built, args.out)
     agree = {title: dict(t.agrees.value_counts()) for title, t in built.items()}
-    print(json.dumps({"markdown": str(paths["md"]), "latex": str(paths["tex"]),
+    print(json_text({"markdown": str(paths["md"]), "latex": str(paths["tex"]),
                       "agreement": {k: {str(a): int(n) for a, n in v.items()} for k, v in agree.items()}}))
     return 0
 
@@ -305,12 +500,12 @@ def _cmd_identify_decrement(args) -> int:
         length, _, inertia, mu = _parameters(args).beam(args.beam)
         beam = dict(mu=mu, length=length, area_moment=inertia)
     d = log_decrement(args.x1, args.xn, args.t1, args.tn, args.n, **beam)
-    print(json.dumps({**d._asdict(), "E_gpa": d.E_gpa}))
+    print(json_text({**d._asdict(), "E_gpa": d.E_gpa}))
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="workbench", description="Loose bolted lap joint workbench (9-DOF Gibbs-Appell model).")
     parser.add_argument("--version", action="version", version=f"workbench {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -325,10 +520,11 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="simulate one run with contact (MODEL.md §7-9)")
     _add_model_options(run)
     _add_joint_options(run)
-    _add_drive_options(run, ramp_default=1.0)
-    run.add_argument("--duration", type=float, default=1.0, help="simulated time (s)")
-    run.add_argument("--dt", type=float, help="RK4 step (s); default from the model's fastest mode")
-    run.add_argument("--output-hz", type=float, default=1000.0, help="sample rate of the signals")
+    _add_drive_options(run, ramp_help=f"soft-start ramp of sine/chirp (s); default "
+                                      f"{DEFAULT_RAMP_S:g} s, or half the run if shorter")
+    run.add_argument("--duration", type=_number(0, MAX_DURATION_S, lo_open=True), default=1.0, help="simulated time (s)")
+    run.add_argument("--dt", type=_number(MIN_DT, MAX_DT), help="RK4 step (s); default from the model's fastest mode")
+    run.add_argument("--output-hz", type=_number(0, MAX_OUTPUT_HZ, lo_open=True), default=1000.0, help="sample rate of the signals")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")
     run.add_argument("--out", metavar="FILE.parquet", help="write the signals (and events) to Parquet")
@@ -337,7 +533,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sweep = sub.add_parser("sweep", help="run a study's grid (TOML) in parallel, resumably")
     sweep.add_argument("study", help="study definition, e.g. studies/default.toml")
-    sweep.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
+    sweep.add_argument("--jobs", type=_number(1, 256, integer=True), default=2, help="worker processes (default 2)")
     sweep.add_argument("--scheduler", default=None,
                        help="Dask scheduler address (tcp://host:port): run on that cluster")
     sweep.add_argument("--fresh", action="store_true", help="discard finished points first")
@@ -345,6 +541,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
     sweep.add_argument("--no-report", action="store_true",
                        help="skip the figures, tables and report.md")
+    sweep.add_argument("--dry-run", action="store_true",
+                       help="check the study, print its grid size and expected cost, run nothing")
     sweep.set_defaults(func=_cmd_sweep)
 
     report = sub.add_parser("report", help="figures, tables and report.md of a study already run")
@@ -355,7 +553,7 @@ def build_parser() -> argparse.ArgumentParser:
     compare = sub.add_parser("compare", help="a measurement file against the matching simulation")
     compare.add_argument("file", help="a .lvm or tab-delimited record (Table 2 channels)")
     _add_record_options(compare)
-    compare.add_argument("--threshold", type=float, default=0.5,
+    compare.add_argument("--threshold", type=_number(0, lo_open=True), default=0.5,
                          help="contact patch voltage that counts as touched (V)")
     compare.add_argument("--out", help="output folder (default results/compare/<file stem>)")
     compare.set_defaults(func=_cmd_compare)
@@ -366,8 +564,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="a parameter to fit and its start (CGS; force_n in N), repeatable; "
                           "fittable: e_a, e_b, zeta_a, zeta_b, mu, cork_k, cork_c, force_n")
     _add_record_options(est)
-    est.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
-    est.add_argument("--max-nfev", type=int, default=30, help="most residual evaluations")
+    est.add_argument("--jobs", type=_number(1, 256, integer=True), default=2, help="worker processes (default 2)")
+    est.add_argument("--max-nfev", type=_number(1, 100000, integer=True), default=30, help="most residual evaluations")
     est.add_argument("--out", metavar="FILE.csv", help="write the fitted values")
     est.set_defaults(func=_cmd_estimate)
 
@@ -393,13 +591,71 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+def json_text(obj) -> str:
+    """JSON without NaN or Infinity: such a number becomes null, its reason in ``"nulls"``."""
+    nulls: dict[str, str] = {}
+
+    def clean(value, where):
+        if isinstance(value, float) and not math.isfinite(value):
+            nulls[where] = f"not a finite number ({value!r})"
+            return None
+        if isinstance(value, dict):
+            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [clean(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        if hasattr(value, "item") and not isinstance(value, (str, bytes)):
+            return clean(value.item(), where)        # numpy scalars
+        return value
+
+    out = clean(obj, "")
+    if nulls and isinstance(out, dict):
+        out["nulls"] = nulls
+    return json.dumps(out, allow_nan=False, default=str)
+
+
+def _crash_report(argv) -> Path:
+    """Write the current exception's traceback to a file; return its path."""
+    folder = Path(os.environ.get("WORKBENCH_CRASH_DIR") or
+                  Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "workbench")
     try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        import tempfile
+        folder = Path(tempfile.gettempdir())
+    path = folder / f"crash-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.txt"
+    path.write_text(f"workbench {__version__}\nargv: {argv!r}\n\n{traceback.format_exc()}")
+    return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (:data:`EXIT_CODES`), never raises."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        args = build_parser().parse_args(argv)
         return args.func(args)
-    except ParameterError as exc:
-        print(f"workbench: error: {exc}", file=sys.stderr)
-        return 2
+    except ParameterError as exc:                 # bad input, refused before the work
+        print(f"workbench: error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except SystemExit as exc:                     # --help, --version
+        return exc.code if isinstance(exc.code, int) else EXIT_OK
+    except KeyboardInterrupt:
+        print("workbench: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        return EXIT_OK
+    except Exception as exc:                      # noqa: BLE001 - our bug: say where it is
+        try:
+            where = f"traceback in {_crash_report(argv)}"
+        except OSError:
+            where = "the traceback could not be written"
+        print(f"workbench: internal error: {type(exc).__name__}: {_one_line(exc)} ({where}); "
+              "please report it", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text if len(text) <= 400 else text[:397] + "..."
 
 
 if __name__ == "__main__":

@@ -53,7 +53,12 @@ def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = N
     exc = {"kind": kind}
     for key in EXCITATION_KEYS[kind]:
         if key in settings:
-            exc[key] = float(settings.pop(key))
+            value = settings.pop(key)
+            try:
+                exc[key] = float(value)
+            except (TypeError, ValueError, OverflowError):
+                raise ParameterError(f"{key} = {value!r} is not a number (WB_{key} in the file, "
+                                     "or its option)") from None
         elif key in EXCITATION_DEFAULTS:
             exc[key] = EXCITATION_DEFAULTS[key]
         else:

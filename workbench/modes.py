@@ -61,6 +61,23 @@ def mode_shapes(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.nd
     return _to_hz(lam), vec, names
 
 
+#: The largest condition number of M accepted: beyond it double precision
+#: cannot separate the modes (a mass of 1e300 g beside one of 1e2 g).
+MAX_MASS_CONDITION = 1e12
+
+
+def _check_conditioned(M, K, joint) -> None:
+    """M and K finite, M positive definite and well conditioned, else a ParameterError."""
+    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(K))):
+        raise ParameterError(f"the linear model (joint {joint}) has non-finite mass or stiffness "
+                             "entries: a mass, length or modulus is out of scale")
+    eig = np.linalg.eigvalsh(0.5 * (M + M.T))
+    if not eig[0] > 0.0 or eig[-1] / eig[0] > MAX_MASS_CONDITION:
+        raise ParameterError(f"the mass matrix (joint {joint}) is not positive definite or is "
+                             f"ill-conditioned (eigenvalues {eig[0]:.3g} .. {eig[-1]:.3g}): "
+                             "a mass or length is out of scale")
+
+
 def linear_eigenvalues(p: Parameters) -> np.ndarray:
     """Eigenvalues (1/s) of the damped linear system, joint free and locked (concatenated).
 
@@ -77,6 +94,7 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
         if ly.S in model.free:
             C[names.index("s"), names.index("s")] += p.cork_law[2]
         n = len(names)
+        _check_conditioned(M, K, joint)
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
         out.append(np.linalg.eigvals(A))

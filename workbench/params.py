@@ -250,6 +250,9 @@ class Parameters:
             if extra:
                 raise ParameterError(f"{path}: keys outside [model]: {extra}")
             data = data["model"]
+            if not isinstance(data, dict):
+                raise ParameterError(f"{path}: [model] must be a table of parameters, got "
+                                     f"{str(data)[:40]!r}")
         try:
             return cls.from_user(data)
         except ParameterError as exc:
@@ -268,17 +271,38 @@ def read_toml(path: Path, error=None) -> dict[str, Any]:
     """The parsed TOML file; ``error`` (default ParameterError) names the file on failure."""
     error = error or ParameterError
     try:
-        return tomllib.loads(Path(path).read_text())
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not a UTF-8 text file (byte {exc.start}); TOML is UTF-8 text") \
+            from None
+    except RecursionError:
+        raise error(f"{path}: not valid TOML: nested too deeply") from None
     except OSError as exc:
-        raise error(f"{path}: cannot read: {exc.strerror}") from None
+        raise error(f"{path}: cannot read: {exc.strerror or exc}") from None
+    _check_integers(data, path, error)
+    return data
+
+
+def _check_integers(value, path, error, where="") -> None:
+    """Refuse integers too large for a float (TOML allows 64-bit; Python parses any)."""
+    if isinstance(value, bool):
+        return
+    if isinstance(value, int) and abs(value) > 2 ** 63:
+        raise error(f"{path}: {where or 'a value'} = {str(value)[:20]}... is too large a number")
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _check_integers(v, path, error, f"{where}.{k}" if where else str(k))
+    elif isinstance(value, list):
+        for v in value:
+            _check_integers(v, path, error, where)
 
 
 def check_positive(name: str, value, unit: str, allow_zero: bool = False) -> float:
     """``value`` as a float if it is a finite number > 0 (>= 0 with allow_zero), else
     a ParameterError naming the parameter and the allowed range."""
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and _finite(value)
     if not ok or value < 0 or (value == 0 and not allow_zero):
         allowed = "[0, inf)" if allow_zero else "(0, inf)"
         raise ParameterError(f"{name} = {value!r} {unit} is outside the allowed range {allowed} {unit}")
@@ -335,10 +359,20 @@ def _range_text(meta) -> str:
     return f"{left}{lo_text}, {hi_text}{right}"
 
 
+def _finite(value) -> bool:
+    """math.isfinite that also refuses integers too large for a float."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
 def _check_number(name, value, meta):
     unit = meta["unit"]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(f"{name} must be a number ({unit}), got {value!r}")
+    if isinstance(value, int) and not _finite(value):
+        raise ParameterError(f"{name} = {str(value)[:20]}... is too large a number ({unit})")
     if math.isnan(value) or (math.isinf(value) and not (meta["allow_inf"] and value > 0)):
         allowed = "finite or inf" if meta["allow_inf"] else "finite"
         raise ParameterError(f"{name} must be {allowed}, got {value!r} ({unit})")
@@ -354,7 +388,7 @@ def _validate(p: Parameters) -> None:
     for f in dataclasses.fields(p):
         value = getattr(p, f.name)
         if f.name == "cork":
-            if value not in CORK_MODELS:
+            if not isinstance(value, str) or value not in CORK_MODELS:
                 raise ParameterError(
                     f"cork = {value!r} is not a cork model; valid: {', '.join(CORK_MODELS)}")
         elif f.name == "tip_mass":

@@ -24,6 +24,7 @@ import pandas as pd
 from . import figures as F
 from .points import point_title
 from .provenance import environment
+from .store import read_runs, write_text_atomic
 from .study import Study
 from .tables import write_tables
 
@@ -82,7 +83,8 @@ def make_report(study: Study, results: str | Path = "results") -> Path:
     provenance = {**environment(), "study": study_definition(study),
                   "points": summary(table), "report_wall_s": report_wall,
                   "runs": read_runs(out)}
-    (out / "provenance.json").write_text(json.dumps(provenance, indent=2, default=str) + "\n")
+    write_text_atomic(json.dumps(provenance, indent=2, default=str) + "\n",
+                      out / "provenance.json")
     index = out / "report.md"
     index.write_text(render_index(study, table, made, tables, out))
     return index
@@ -103,11 +105,6 @@ def summary(table: pd.DataFrame) -> dict:
             "not_steady": int((~ok.steady.astype(bool)).sum()) if len(ok) else 0,
             "cpu_s": float(table.wall_s.sum()) if len(table) else 0.0,
             "simulated_s": float(ok.simulated_s.sum()) if len(ok) else 0.0}
-
-
-def read_runs(out: Path) -> list:
-    path = out / "runs.json"
-    return json.loads(path.read_text()) if path.exists() else []
 
 
 def render_index(study, table, figures, tables, out) -> str:

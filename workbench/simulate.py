@@ -13,6 +13,8 @@ Units are CGS (MODEL.md); ``run.units`` names them per column.
 """
 from __future__ import annotations
 
+import functools
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -23,6 +25,7 @@ from . import model as mdl
 from .core import layout as ly
 from .core.hybrid import run_hybrid
 from .excitation import none
+from .limits import MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD
 from .metrics import contact_shares
 from .params import ParameterError, Parameters, check_positive
 from .statics import static_equilibrium, tip_load_for_deflection
@@ -57,8 +60,7 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
     imaginary axis where RK4 is stable to |lambda dt| = 2.83.  A hammer
     pulse gets at least PULSE_STEPS steps.
     """
-    from .modes import linear_eigenvalues
-    lam = STABILITY_MARGIN * linear_eigenvalues(p)
+    lam = STABILITY_MARGIN * _eigenvalues(p)
     limit = MAX_DEFAULT_DT
     if excitation is not None and int(excitation[ly.X_KIND]) in (ly.EXC_HAMMER_JOINT,
                                                                  ly.EXC_HAMMER_TIP):
@@ -68,6 +70,112 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
             return dt
     return NICE_STEPS[-1]
 
+
+@functools.lru_cache(maxsize=256)
+def _eigenvalues(p: Parameters) -> np.ndarray:
+    """:func:`workbench.modes.linear_eigenvalues`, once per parameter set (read-only)."""
+    from .modes import linear_eigenvalues
+    lam = linear_eigenvalues(p)
+    lam.flags.writeable = False
+    return lam
+
+
+def stability_limit(p: Parameters) -> float:
+    """The largest step (s) at which RK4 is stable for the linear model's eigenvalues.
+
+    No margin (:func:`default_dt` keeps STABILITY_MARGIN below it): a step
+    above this grows the fastest mode without bound.
+    """
+    lam = _eigenvalues(p)
+    lo, hi = 0.0, 3.0 / float(np.abs(lam).max())
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if np.all(rk4_amplification(lam * mid) <= 1.0):
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: float | None,
+                   output_hz: float, t0: float = 0.0, names: dict | None = None,
+                   stability: bool = True) -> tuple[float, int, int]:
+    """Check a run's settings against what its step can resolve; return (dt, decim, n_steps).
+
+    The step (given or :func:`default_dt`) must be RK4-stable for the model
+    (``stability``; :func:`stability_limit`), resolve the drive
+    (STEPS_PER_PERIOD steps per period of a sine or a chirp's highest
+    frequency, MIN_PULSE_STEPS per hammer pulse) and divide the output
+    interval and the duration; a hammer hit and a soft-start ramp must end
+    within the run.  ``names`` maps the setting names (duration, dt,
+    output_hz, freq_hz, f0_hz, f1_hz, width_s, t_hit_s, ramp_s) to the
+    names the user wrote (an option, a study key), for the messages.
+    Raises ParameterError.
+    """
+    names = names or {}
+
+    def name(key):
+        return names.get(key, key)
+
+    duration = check_positive(name("duration"), duration, "s")
+    if duration > MAX_DURATION_S:
+        raise ParameterError(f"{name('duration')} = {duration:g} s is outside the allowed range "
+                             f"(0, {MAX_DURATION_S:g}] s")
+    t0 = check_positive("t0", t0, "s", allow_zero=True)
+    given = dt is not None
+    if given:
+        dt = check_positive(name("dt"), dt, "s")
+        if not MIN_DT <= dt <= MAX_DT:
+            raise ParameterError(f"{name('dt')} = {dt:g} s is outside the allowed range "
+                                 f"[{MIN_DT:g}, {MAX_DT:g}] s")
+        if stability:
+            limit = stability_limit(params)
+            if dt > limit:
+                raise ParameterError(
+                    f"{name('dt')} = {dt:g} s is above this model's RK4 stability limit "
+                    f"{limit:.3g} s (its fastest linear mode); give at most that, or leave it out "
+                    f"for the default {default_dt(params, ex):g} s")
+    else:
+        dt = default_dt(params, ex)
+    output_hz = check_positive(name("output_hz"), output_hz, "Hz")
+    decim = round(1.0 / (output_hz * dt)) if output_hz * dt > 1e-12 else 0
+    if decim < 1 or abs(decim * dt * output_hz - 1.0) > 1e-9:
+        raise ParameterError(f"{name('output_hz')} = {output_hz:g} Hz must divide 1/dt = "
+                             f"{1 / dt:g} Hz into whole steps (dt = {dt:g} s)")
+    n_steps = round(duration / dt)
+    if abs(n_steps * dt - duration) > 1e-9 * duration:
+        raise ParameterError(f"{name('duration')} = {duration:g} s is not a whole number of "
+                             f"steps dt = {dt:g} s")
+    kind = int(ex[ly.X_KIND])
+    f_max = 1.0 / (STEPS_PER_PERIOD * dt)
+    end = t0 + duration
+    if kind == ly.EXC_SINE and ex[ly.X_FREQ] > f_max:
+        raise ParameterError(f"{name('freq_hz')} = {ex[ly.X_FREQ]:g} Hz is above what the step "
+                             f"dt = {dt:g} s resolves ({STEPS_PER_PERIOD} steps per period: at "
+                             f"most {f_max:g} Hz)")
+    if kind == ly.EXC_CHIRP:
+        for key, col in (("f0_hz", ly.X_F0), ("f1_hz", ly.X_F1)):
+            if ex[col] > f_max:
+                raise ParameterError(
+                    f"{name(key)} = {ex[col]:g} Hz is above what the step dt = {dt:g} s resolves "
+                    f"({STEPS_PER_PERIOD} steps per period: at most {f_max:g} Hz)")
+    if kind in (ly.EXC_SINE, ly.EXC_CHIRP) and ex[ly.X_RAMP] > end:
+        raise ParameterError(f"{name('ramp_s')} = {ex[ly.X_RAMP]:g} s: the soft start would "
+                             f"end after the run ({end:g} s)")
+    if kind in (ly.EXC_HAMMER_JOINT, ly.EXC_HAMMER_TIP):
+        width = ex[ly.X_WIDTH]
+        if width < MIN_PULSE_STEPS * dt * (1.0 - 1e-9):
+            raise ParameterError(f"{name('width_s')} = {width:g} s is shorter than "
+                                 f"{MIN_PULSE_STEPS} steps dt = {dt:g} s: the step cannot "
+                                 "resolve the pulse (give a smaller dt or leave it out)")
+        if ex[ly.X_T_HIT] + width > end:
+            raise ParameterError(f"{name('t_hit_s')} = {ex[ly.X_T_HIT]:g} s: the pulse of "
+                                 f"{width:g} s would end after the run ({end:g} s)")
+    return dt, decim, n_steps
+
+
+#: The smallest energy scale (erg) of :meth:`Run.energy_balance_rel`.
+ENERGY_SCALE_FLOOR_ERG = 1.0
 
 #: Run statistics of the contact logic reported by :meth:`Run.summary` (MODEL.md §7).
 CONTACT_STAT_KEYS = ("accumulations", "accumulation_energy_lost_erg", "inconsistent_resolved",
@@ -101,6 +209,7 @@ class Run:
     initial: str
     units: dict = field(default_factory=dict)
     t0: float = 0.0
+    compile_s: float = 0.0      # compiling or loading the kernel (not in wall_s)
 
     @property
     def ok(self) -> bool:
@@ -135,14 +244,21 @@ class Run:
         return e
 
     def energy_balance_rel(self) -> float:
-        """Largest |residual| over the energy throughput (|W| + dissipations, or max T)."""
+        """Largest |residual| over the run's energy scale (MODEL.md §9).
+
+        The scale is the throughput |W_excitation| + dissipations at the end,
+        plus the largest kinetic energy and the largest change of the
+        mechanical energy E from E(0) (so that a free decay, whose throughput
+        starts at zero, reads sensibly from its first sample), floored at
+        ENERGY_SCALE_FLOOR_ERG: a run that stays at rest divides its
+        round-off residual by 1 erg, not by a near-zero throughput.
+        """
         e = self.energy
         last = e.iloc[-1]
-        throughput = (abs(last.w_excitation) + last.d_structural + last.d_cork + last.d_friction
-                      + last.d_impact)
-        if throughput <= 0.0:
-            throughput = float(e.e_kin.max())
-        return float(np.abs(e.residual).max() / throughput) if throughput > 0 else 0.0
+        scale = (abs(last.w_excitation) + last.d_structural + last.d_cork + last.d_friction
+                 + last.d_impact + float(e.e_kin.max())
+                 + float(np.abs(e.total - e.total.iloc[0]).max()))
+        return float(np.abs(e.residual).max() / max(scale, ENERGY_SCALE_FLOOR_ERG))
 
     def contact_time_share(self) -> dict[str, float]:
         """Fraction of the simulated time spent in each contact code (from the event log)."""
@@ -159,6 +275,7 @@ class Run:
             "message": self.message,
             "simulated_s": self.simulated_s,
             "wall_s": self.wall_s,
+            "compile_s": self.compile_s,
             "dt": self.dt,
             "initial": self.initial,
             "n_events": int((self.events.kind != "start").sum()),
@@ -167,6 +284,7 @@ class Run:
             "contact_time_share": self.contact_time_share(),
             "max_penetration_cm": float(self.stats["max_penetration_cm"]),
             "max_drift_cm": float(self.stats["max_drift_cm"]),
+            "max_correction_cm": float(self.stats["max_correction_cm"]),
             "energy_balance_rel": self.energy_balance_rel(),
             "impact_energy_lost_erg": float(self.stats["impact_energy_lost_erg"]),
             **{key: self.stats[key] for key in CONTACT_STAT_KEYS},
@@ -252,25 +370,11 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     """
     if not isinstance(params, Parameters):
         raise ParameterError(f"params must be workbench.params.Parameters, got {type(params).__name__}")
-    duration = check_positive("duration", duration, "s")
-    t0 = check_positive("t0", t0, "s", allow_zero=True)
     ex = none() if excitation is None else np.asarray(excitation, dtype=float)
     if ex.shape != (ly.N_EXC,):
         raise ParameterError("excitation must come from workbench.excitation (an array of "
                              f"{ly.N_EXC} values)")
-    dt = default_dt(params, ex) if dt is None else check_positive("dt", dt, "s")
-    if dt > 1e-3:
-        raise ParameterError(f"dt = {dt} s is outside the allowed range (0, 1e-3] s "
-                             "(RK4 is unstable above ~1.3e-4 s with the tip mass, "
-                             "~3e-5 s without)")
-    output_hz = check_positive("output_hz", output_hz, "Hz")
-    decim = round(1.0 / (output_hz * dt))
-    if decim < 1 or abs(decim * dt * output_hz - 1.0) > 1e-9:
-        raise ParameterError(f"output_hz = {output_hz} Hz must divide 1/dt = {1 / dt:g} Hz "
-                             "into whole steps")
-    n_steps = round(duration / dt)
-    if abs(n_steps * dt - duration) > 1e-9 * duration:
-        raise ParameterError(f"duration = {duration} s is not a whole number of steps dt = {dt} s")
+    dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, stability=False)
     if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
         raise ParameterError("free_decay_cm releases the structure without excitation; "
                              "leave excitation unset")
@@ -294,6 +398,9 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
+    compile_s = compile_kernel((y, float(t0), dt, 1, 0, decim, *model, ex, *work, np.empty(1),
+                                np.empty((1, ly.N_STATE)), np.empty((1, ly.N_SIG)),
+                                np.empty((1, ly.N_LOG)), st))
     t_wall = time.perf_counter()
     while done < n_steps:
         n = min(chunk, n_steps - done)
@@ -324,8 +431,33 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     wall = time.perf_counter() - t_wall
     if bar is not None:
         bar.close()
-    return _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
-                     st, static_tip, label, t0)
+    run = _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
+                    st, static_tip, label, t0)
+    run.compile_s = compile_s
+    return run
+
+
+#: What the first compile of the kernels takes (README "Install"), for the message.
+COMPILE_NOTE = "about 8 minutes on 2 cores"
+
+
+def compile_kernel(args) -> float:
+    """Compile the run kernel for these arguments' types, or load it from numba's cache.
+
+    Returns the seconds spent (0 when already in this process).  When no
+    cached machine code exists (the first run after an install or a change
+    of ``workbench/core``), says so on stderr first, with the usual time.
+    """
+    import numba
+    if run_hybrid.signatures:
+        return 0.0
+    from .core._cache import CACHE_DIR
+    if not any(CACHE_DIR.glob("hybrid.run_hybrid-*.nbi")):
+        print(f"workbench: compiling the numba kernels ({COMPILE_NOTE}; once, then cached in "
+              f"{CACHE_DIR})", file=sys.stderr, flush=True)
+    t = time.perf_counter()
+    run_hybrid.compile(tuple(numba.typeof(a) for a in args))
+    return time.perf_counter() - t
 
 
 def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log, st,
@@ -360,6 +492,9 @@ def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s,
     units.update(dict(zip(ly.SIGNALS, ly.SIGNAL_UNITS)))
     units.update({"t": "s", "impulse_t": "dyn s", "ke_lost": "erg"})
     stats = {"max_penetration_cm": max(0.0, st[ly.ST_MAX_PEN]), "max_drift_cm": st[ly.ST_MAX_DRIFT],
+             "max_correction_cm": st[ly.ST_MAX_CORRECTION],
+             "t_max_penetration": st[ly.ST_T_MAX_PEN],
+             "max_penetration_where": int(st[ly.ST_PEN_WHERE]),
              "impact_energy_lost_erg": st[ly.ST_E_IMPACT], "t_reached": st[ly.ST_T],
              "steps": int(st[ly.ST_STEP]),
              "accumulations": int(st[ly.ST_N_ACCUM]),

@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from . import excitation as X
+from .limits import FREE_DECAY_MAX_CM, MAX_NAME_CHARS
 from .params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 #: Excitation kinds and the keys each accepts (user units in the names).
@@ -169,14 +170,22 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     unknown = sorted(set(data) - {"study", "excitation", "fixed", "axes"})
     if unknown:
         raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [fixed], [axes]")
+    for table in ("study", "excitation", "fixed", "axes"):
+        if table in data and not isinstance(data[table], dict):
+            raise StudyError(f"[{table}] must be a table of keys, got {_short(data[table])}")
     head = dict(data.get("study", {}))
     bad = sorted(set(head) - STUDY_KEYS)
     if bad:
         raise StudyError(f"unknown key(s) {bad} in [study]; allowed: {sorted(STUDY_KEYS)}")
     name = head.get("name")
     if not isinstance(name, str) or not name or not all(c.isalnum() or c in "-_" for c in name):
-        raise StudyError(f"[study] name = {name!r} must be a non-empty word of letters, "
+        raise StudyError(f"[study] name = {_short(name)} must be a non-empty word of letters, "
                          "digits, '-' and '_' (it names results/<name>/)")
+    if len(name) > MAX_NAME_CHARS:
+        raise StudyError(f"[study] name is {len(name)} characters long; at most {MAX_NAME_CHARS} "
+                         "(it names a folder)")
+    if not isinstance(head.get("description", ""), str):
+        raise StudyError(f"[study] description must be a string, got {_short(head['description'])}")
     duration = check_positive("[study] duration_s", head.get("duration_s"), "s")
     window = check_positive("[study] window_s", head.get("window_s", min(2.0, duration / 2)), "s")
     if window > duration / 2:
@@ -204,10 +213,19 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     axes = dict(data.get("axes", {}))
     for key, values in axes.items():
         if not isinstance(values, list) or not values:
-            raise StudyError(f"[axes] {key} must be a non-empty list of values, got {values!r}")
-        if len(set(map(repr, values))) != len(values):
-            raise StudyError(f"[axes] {key} lists a value twice: {values}")
+            raise StudyError(f"[axes] {key} must be a non-empty list of values, got {_short(values)}")
+        for v in values:
+            if not isinstance(v, (bool, int, float, str)):
+                raise StudyError(f"[axes] {key}: each value must be a number, true/false or a "
+                                 f"string, got {_short(v)}")
+        if len(set(map(_value_key, values))) != len(values):
+            raise StudyError(f"[axes] {key} lists a value twice: {_short(values)}")
     allowed_exc = set(EXCITATION_KEYS[kind])
+    for key, value in list(exc.items()) + list(fixed.items()):
+        if not isinstance(value, (bool, int, float, str)):
+            table = "excitation" if key in exc else "fixed"
+            raise StudyError(f"[{table}] {key} must be a number, true/false or a string, "
+                             f"got {_short(value)}")
     for table, keys in (("excitation", exc), ("axes", axes), ("fixed", fixed)):
         for key in keys:
             if key in allowed_exc:
@@ -233,22 +251,35 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                          "excitation with freq_hz in [axes]")
 
     names = list(axes)
+    where = {"duration": "[study] duration_s", "dt": "[study] dt", "output_hz": "[study] output_hz"}
+    for k in allowed_exc:
+        where[k] = f"[axes] {k}" if k in axes else f"[excitation] {k}"
     points = []
     for combo in itertools.product(*(axes[n] for n in names)):
         values = dict(zip(names, combo))
         model_values = {**fixed, **{k: v for k, v in values.items() if k not in allowed_exc}}
-        params = Parameters.from_user(model_values)
-        settings = {"kind": kind}
-        for k in EXCITATION_KEYS[kind]:
-            settings[k] = values.get(k, exc.get(k, EXCITATION_DEFAULTS.get(k)))
-        pt = Point(values=values, params=params, excitation=settings)
-        pt.excitation_array()                      # validates the excitation values
+        try:
+            params = Parameters.from_user(model_values)
+            settings = {"kind": kind}
+            for k in EXCITATION_KEYS[kind]:
+                settings[k] = values.get(k, exc.get(k, EXCITATION_DEFAULTS.get(k)))
+            pt = Point(values=values, params=params, excitation=settings)
+            _check_point(pt, duration, dt, output_hz, where)
+        except StudyError:
+            raise
+        except ParameterError as exc_:
+            at = f" (at {_short(values)})" if values else ""
+            raise StudyError(f"{exc_}{at}") from None
         points.append(pt)
     if sweep != "independent":
         points = _stepped(points, sweep)
     else:
         points = [Point(p.values, p.params, p.excitation, chain=i) for i, p in enumerate(points)]
-    series = tuple(dict(s) for s in head.get("save_series", []))
+    raw = head.get("save_series", [])
+    if not isinstance(raw, list) or not all(isinstance(sel, dict) for sel in raw):
+        raise StudyError("[study] save_series must be a list of tables such as "
+                         f"[{{gap_mm = 1.016}}], got {_short(raw)}")
+    series = tuple(dict(s) for s in raw)
     for sel in series:
         bad = sorted(set(sel) - set(names) - set(allowed_exc))
         if bad:
@@ -257,6 +288,39 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
                  excitation={"kind": kind, **exc}, fixed=fixed, axes=axes, save_series=series,
                  source=source, points=tuple(points))
+
+
+def _short(value) -> str:
+    """repr of a value, cut to 60 characters for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _value_key(value):
+    """Axis values equal as numbers are the same value (1 and 1.0)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        try:
+            return ("number", float(value))
+        except OverflowError:
+            return ("number", str(value))
+    return (type(value).__name__, value)
+
+
+def _check_point(point: Point, duration, dt, output_hz, where) -> None:
+    """A point's excitation values, and its run settings against what the step resolves."""
+    from .simulate import check_settings, stability_limit
+    ex = point.excitation_array()                  # validates the excitation values
+    if point.excitation["kind"] == "free_decay":
+        x = point.excitation.get("deflection_cm")
+        ok = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+        if not ok or abs(x) > FREE_DECAY_MAX_CM:
+            raise StudyError(f"{where['deflection_cm']} = {_short(x)} cm is outside the allowed "
+                             f"range [-{FREE_DECAY_MAX_CM:g}, {FREE_DECAY_MAX_CM:g}] cm")
+    if dt is not None and dt > stability_limit(point.params):
+        raise StudyError(f"[study] dt = {dt:g} s is above the RK4 stability limit "
+                         f"{stability_limit(point.params):.3g} s of the model at "
+                         f"{_short(point.values)}; give at most that, or leave dt out")
+    check_settings(point.params, ex, duration, dt, output_hz, names=where, stability=False)
 
 
 def _stepped(points, sweep):

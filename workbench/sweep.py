@@ -1,4 +1,4 @@
-"""Run a study's grid in parallel, resumably (issue 4).
+"""Run a study's grid in parallel, resumably.
 
     results/<study>/points/<key>.parquet   one row per finished point, written atomically
     results/<study>/series/<key>.parquet   time series of the points the study names
@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import sys
 import time
 import traceback
 from pathlib import Path
@@ -35,7 +36,14 @@ from .core import layout as ly
 from .metrics import contact_checks, point_metrics
 from .provenance import code_version
 from .simulate import default_dt, simulate
+from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
 from .study import Point, Study
+
+#: Wall seconds per RK4 step assumed by :func:`plan` when the study has no
+#: run log yet (a contact-rich 10 s point at 1e-4 s takes ~1-2 s).
+SECONDS_PER_STEP = 2e-5
+#: A worker whose sweep process is gone stops within this many seconds.
+WATCHDOG_S = 1.0
 
 STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
 
@@ -60,12 +68,6 @@ def chain_keys(study: Study, chain: list[Point]) -> list[str]:
     return keys
 
 
-def _write_atomic(df: pd.DataFrame, path: Path) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    df.to_parquet(tmp)
-    os.replace(tmp, path)
-
-
 def _row(point, key, status, message, wall, metrics, run=None, continued=False):
     row = {"key": key, **{f"axis_{k}": v for k, v in point.values.items()},
            "chain": point.chain, "step": point.step, "direction": point.direction,
@@ -77,6 +79,7 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
         row["n_impacts"] = int((run.events.kind == "impact").sum())
         row["max_penetration_cm"] = float(run.stats["max_penetration_cm"])
         row["max_drift_cm"] = float(run.stats["max_drift_cm"])
+        row["max_correction_cm"] = float(run.stats["max_correction_cm"])
         row["energy_balance_rel"] = run.energy_balance_rel()
         row.update(contact_checks(run))
         row["static_tip_y"] = run.static_tip_y
@@ -99,25 +102,32 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> 
         row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)
         if study.saves_series(point):
-            _write_atomic(run.signals, out / "series" / f"{key}.parquet")
-            _write_atomic(run.events.astype({"kind": str}), out / "series" / f"{key}.events.parquet")
+            write_atomic(run.signals, out / "series" / f"{key}.parquet")
+            write_atomic(run.events.astype({"kind": str}), out / "series" / f"{key}.events.parquet")
     except Exception as exc:          # noqa: BLE001 - a failed point is data, the sweep goes on
         msg = f"{type(exc).__name__}: {exc}"
         row = _row(point, key, "error", msg, time.perf_counter() - t0, {},
                    continued=continued)
         row["traceback"] = traceback.format_exc(limit=5)
-    _write_atomic(pd.DataFrame([row]), out / "points" / f"{key}.parquet")
+    write_atomic(pd.DataFrame([row]), out / "points" / f"{key}.parquet")
     return row
 
 
-def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path) -> list[dict]:
-    """Run a chain's points in order, skipping finished ones (their state carries on)."""
+def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path,
+              sweep_pid: int | None = None) -> list[dict]:
+    """Run a chain's points in order, skipping finished ones (their state carries on).
+
+    ``sweep_pid``: the sweep's process; a worker on this machine stops
+    itself when that process is gone (a killed sweep leaves no worker).
+    """
+    if sweep_pid is not None and sweep_pid != os.getpid():
+        _watch(sweep_pid)
     rows = []
     state = None
     for point, key in zip(chain, keys):
-        path = out / "points" / f"{key}.parquet"
-        if path.exists():
-            row = pd.read_parquet(path).iloc[0].to_dict()
+        found = read_point(out / "points" / f"{key}.parquet")
+        if found is not None:
+            row = found.iloc[0].to_dict()
         else:
             row = run_point(study, point, key, out, initial=state)
         rows.append(row)
@@ -127,50 +137,120 @@ def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path) -> l
     return rows
 
 
+_WATCHED: set = set()
+
+
+def _watch(pid: int) -> None:
+    """In a worker: a daemon thread that ends the process once ``pid`` has gone."""
+    if pid in _WATCHED:
+        return
+    _WATCHED.add(pid)
+    import threading
+
+    def watch():
+        while True:
+            time.sleep(WATCHDOG_S)
+            try:
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:
+                pass
+
+    threading.Thread(target=watch, name="sweep-watchdog", daemon=True).start()
+
+
 def estimated_cost(study: Study, chain: list[Point]) -> float:
     """RK4 steps of a chain: the longest chains start first, so that workers finish together."""
-    return sum(study.duration_s / (study.dt or default_dt(p.params)) for p in chain)
+    return sum(study.duration_s / (study.dt or default_dt(p.params, p.excitation_array()))
+               for p in chain)
 
 
-def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
-              scheduler: str | None = None, fresh: bool = False, progress: bool = True) -> pd.DataFrame:
-    """Run every unfinished point of the study; return (and write) points.parquet."""
-    out = Path(results) / study.name
-    if fresh and (out / "points").exists():
-        for f in (out / "points").glob("*.parquet"):
-            f.unlink()
-    for sub in ("points", "series"):
-        (out / sub).mkdir(parents=True, exist_ok=True)
-        for tmp in (out / sub).glob(".*.tmp"):         # leftovers of a killed run
-            tmp.unlink(missing_ok=True)
+def _unfinished(study: Study, out: Path):
     chains = study.chains()
     keys = [chain_keys(study, c) for c in chains]
     todo = [(c, k) for c, k in zip(chains, keys)
             if not all((out / "points" / f"{key}.parquet").exists() for key in k)]
-    todo.sort(key=lambda item: -estimated_cost(study, item[0]))
-    n_points = sum(len(c) for c, _ in todo)
-    if todo:
-        t0 = time.perf_counter()
-        _execute(study, todo, out, jobs, scheduler, progress, n_points)
-        _log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "points_run": n_points,
-                       "jobs": jobs, "scheduler": scheduler,
-                       "wall_s": time.perf_counter() - t0})
-    rows = []
-    for k in keys:
-        for key in k:
-            path = out / "points" / f"{key}.parquet"
-            if path.exists():
-                rows.append(pd.read_parquet(path))
-    table = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
-    _write_atomic(table, out / "points.parquet")
+    return keys, todo
+
+
+def plan(study: Study, results: str | Path = "results", fresh: bool = False,
+         jobs: int = 2) -> dict:
+    """What a sweep would do: points, how many are finished, the expected steps and wall time.
+
+    The wall time uses the study's own past seconds per step (runs.json) if
+    it has run before, else SECONDS_PER_STEP; divided by the workers.
+    """
+    out = Path(results) / study.name
+    if fresh:
+        keys, todo = [chain_keys(study, c) for c in study.chains()], \
+            [(c, chain_keys(study, c)) for c in study.chains()]
+    else:
+        keys, todo = _unfinished(study, out)
+    steps = sum(estimated_cost(study, c) for c, _ in todo)
+    per_step, basis = SECONDS_PER_STEP, "assumed"
+    past = [r for r in read_runs(out) if r.get("state") == "done" and r.get("steps")]
+    if past:
+        per_step = sum(r["wall_s"] * r.get("jobs", 1) for r in past) / sum(r["steps"] for r in past)
+        basis = "this study's earlier runs"
+    n_todo = sum(len(c) for c, _ in todo)
+    return {"study": study.name, "points": study.n_points, "to_run": n_todo,
+            "finished": study.n_points - n_todo, "chains": len(keys), "steps": int(steps),
+            "expected_wall_s": float(f"{steps * per_step / max(1, min(jobs, len(todo) or 1)):.3g}"),
+            "seconds_per_step": per_step, "seconds_per_step_from": basis,
+            "results": str(out)}
+
+
+def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
+              scheduler: str | None = None, fresh: bool = False, progress: bool = True) -> pd.DataFrame:
+    """Run every unfinished point of the study; return (and write) points.parquet.
+
+    The study folder is locked while the sweep runs; the invocation is
+    logged in runs.json (running, then done / interrupted / failed).
+    """
+    out = Path(results) / study.name
+    out.mkdir(parents=True, exist_ok=True)
+    with StudyLock(out):
+        if fresh and (out / "points").exists():
+            for f in (out / "points").glob("*.parquet"):
+                f.unlink()
+        for sub in ("points", "series"):
+            (out / sub).mkdir(parents=True, exist_ok=True)
+            for tmp in (out / sub).glob(".*.tmp"):         # leftovers of a killed run
+                tmp.unlink(missing_ok=True)
+        keys, todo = _unfinished(study, out)
+        todo.sort(key=lambda item: -estimated_cost(study, item[0]))
+        n_points = sum(len(c) for c, _ in todo)
+        if todo:
+            if progress:
+                p = plan(study, results, jobs=jobs)
+                print(f"workbench: {study.name}: {n_points} of {study.n_points} points to run, "
+                      f"{p['steps']:.3g} steps, about {p['expected_wall_s']:.0f} s on {jobs} "
+                      "worker(s)", file=sys.stderr)
+            steps = sum(estimated_cost(study, c) for c, _ in todo)
+            t0 = time.perf_counter()
+            index = log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                                  "points_run": n_points, "steps": steps, "jobs": jobs,
+                                  "scheduler": scheduler, "pid": os.getpid(),
+                                  "state": "running"})
+            state = "failed"
+            try:
+                _execute(study, todo, out, jobs, scheduler, progress, n_points)
+                state = "done"
+            except KeyboardInterrupt:
+                state = "interrupted"
+                raise
+            finally:
+                update_run(out, index, {"state": state, "wall_s": time.perf_counter() - t0})
+        rows = []
+        for k in keys:
+            for key in k:
+                row = read_point(out / "points" / f"{key}.parquet")
+                if row is not None:
+                    rows.append(row)
+        table = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
+        write_atomic(table, out / "points.parquet")
     return table
-
-
-def _log_run(out: Path, entry: dict) -> None:
-    """Append an invocation's wall time to runs.json (read by the report's provenance)."""
-    path = out / "runs.json"
-    runs = json.loads(path.read_text()) if path.exists() else []
-    path.write_text(json.dumps(runs + [entry], indent=1) + "\n")
 
 
 def _execute(study, todo, out, jobs, scheduler, progress, n_points):
@@ -180,20 +260,23 @@ def _execute(study, todo, out, jobs, scheduler, progress, n_points):
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_points, unit="point", desc=study.name)
-    tasks = (delayed(run_chain)(study, c, k, out) for c, k in todo)
-    if scheduler:
-        from dask.distributed import Client     # optional: pip install '.[cluster]'
-        client = Client(scheduler)
-        try:
-            with parallel_config(backend="dask"):
-                for rows in Parallel(return_as="generator_unordered")(tasks):
-                    if bar is not None:
-                        bar.update(len(rows))
-        finally:
-            client.close()
-    else:
-        for rows in Parallel(n_jobs=jobs, return_as="generator_unordered")(tasks):
-            if bar is not None:
-                bar.update(len(rows))
-    if bar is not None:
-        bar.close()
+    sweep_pid = None if scheduler else os.getpid()
+    tasks = (delayed(run_chain)(study, c, k, out, sweep_pid) for c, k in todo)
+    try:
+        if scheduler:
+            from dask.distributed import Client     # optional: pip install '.[cluster]'
+            client = Client(scheduler, timeout="10s")
+            try:
+                with parallel_config(backend="dask"):
+                    for rows in Parallel(return_as="generator_unordered")(tasks):
+                        if bar is not None:
+                            bar.update(len(rows))
+            finally:
+                client.close()
+        else:
+            for rows in Parallel(n_jobs=jobs, return_as="generator_unordered")(tasks):
+                if bar is not None:
+                    bar.update(len(rows))
+    finally:
+        if bar is not None:
+            bar.close()

@@ -79,6 +79,9 @@ def log_decrement(x1: float, xn: float, t1: float, tn: float, n: int, *,
     td = (tn - t1) / cycles_td
     if td_round_s is not None:
         td = round(td / td_round_s) * td_round_s
+    if not td > 0.0:
+        raise ParameterError(f"tn - t1 = {tn - t1:g} s over {cycles_td} cycles is a period below "
+                             f"the tabulation step {td_round_s:g} s: the peaks are too close")
     delta = math.log(x1 / xn) / (n - 1)
     zeta = delta / math.sqrt(4.0 * math.pi ** 2 + delta ** 2)
     omega_d = 2.0 * math.pi / td

@@ -1,0 +1,27 @@
+"""The ranges of run settings accepted at the user boundary (command line, studies, API).
+
+Physical parameters carry their ranges in :mod:`workbench.params`; these
+are the settings of a run.  What a given step resolves (drive frequency,
+pulse width) is checked against the step by
+:func:`workbench.simulate.check_settings`.
+"""
+#: The longest run (s) and the shortest step (s).
+MAX_DURATION_S = 1e5
+MIN_DT = 1e-7
+#: The largest step (s): RK4 is unstable far below it for this model; the
+#: model's own limit is :func:`workbench.simulate.stability_limit`.
+MAX_DT = 1e-3
+#: The largest sample rate of the stored signals (Hz).
+MAX_OUTPUT_HZ = 1e6
+#: The largest shaker amplitude or hammer peak (N): 50 times the 200 N of
+#: the paper's validated range.
+MAX_FORCE_N = 1e4
+#: The largest static tip deflection of a free decay (cm, either way): the
+#: tip of beam B has 8.4 cm of travel in the paper (seed §5.3).
+FREE_DECAY_MAX_CM = 20.0
+#: Steps per period of the highest drive frequency at least (sine, chirp ends).
+STEPS_PER_PERIOD = 20
+#: Steps per hammer pulse at least when the step is given.
+MIN_PULSE_STEPS = 5
+#: The longest study name (it names a folder).
+MAX_NAME_CHARS = 100
