@@ -285,6 +285,7 @@ class Run:
             "max_penetration_cm": float(self.stats["max_penetration_cm"]),
             "max_drift_cm": float(self.stats["max_drift_cm"]),
             "max_correction_cm": float(self.stats["max_correction_cm"]),
+            "t_max_penetration": float(self.stats["t_max_penetration"]),
             "energy_balance_rel": self.energy_balance_rel(),
             "impact_energy_lost_erg": float(self.stats["impact_energy_lost_erg"]),
             **{key: self.stats[key] for key in CONTACT_STAT_KEYS},

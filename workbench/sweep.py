@@ -80,6 +80,7 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
         row["max_penetration_cm"] = float(run.stats["max_penetration_cm"])
         row["max_drift_cm"] = float(run.stats["max_drift_cm"])
         row["max_correction_cm"] = float(run.stats["max_correction_cm"])
+        row["t_max_penetration"] = float(run.stats["t_max_penetration"])
         row["energy_balance_rel"] = run.energy_balance_rel()
         row.update(contact_checks(run))
         row["static_tip_y"] = run.static_tip_y
