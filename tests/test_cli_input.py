@@ -120,6 +120,8 @@ CASES = [
     (["sweep", "S", "--jobs", "0"], ["--jobs", "0"]),
     (["sweep", "S", "--scheduler", "not-an-address"], ["--scheduler", "not-an-address"]),
     (["sweep", "S", "--scheduler", "tcp://127.0.0.1:1"], ["--scheduler", "no scheduler"]),
+    (["sweep", "S", "--scheduler", "tcp://[::1:8786"], ["--scheduler", "tcp://HOST:PORT"]),
+    (["sweep", "S", "--scheduler", "tcp://host:port"], ["--scheduler", "tcp://HOST:PORT"]),
     (["sweep", "S", "--results", "F/sub"], ["--results", "a file"]),
     (["report", "S"], ["report", "sweep"]),
     (["estimate", "R", "--fit", "e_b=abc"], ["--fit e_b=abc", "'abc'"]),
@@ -311,5 +313,25 @@ def test_fuzzed_experiment_files_never_crash(cut, junk, files, capsys):
     path.write_bytes(text[:cut] + junk + text[cut + len(junk):])
     code, err = outcome(["compare", str(path)], capsys)
     assert code in ("accepted", cli.EXIT_BAD_INPUT), (code, err)
+    if code == cli.EXIT_BAD_INPUT:
+        assert len(err.strip().splitlines()) == 1, err
+
+
+COMMANDS = [["sweep", "S", "--dry-run"], ["compare", "R"], ["estimate", "R", "--fit", "e_b=6e11"],
+            ["modes"], ["params"], ["identify", "decrement", "1", "0.5", "0", "1", "5"],
+            ["identify", "tables", "--no-table6"]]
+MORE_OPTIONS = OPTIONS + ["--jobs", "--scheduler", "--results", "--fresh", "--skip-s",
+                          "--strain-scale", "--threshold", "--fit", "--max-nfev", "--beam",
+                          "--joint", "--params", "--json"]
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=list(HealthCheck))
+@given(command=st.sampled_from(COMMANDS),
+       pairs=st.lists(st.tuples(st.sampled_from(MORE_OPTIONS), texts), min_size=1, max_size=3))
+def test_fuzzed_options_of_every_command_never_crash(command, pairs, files, capsys):
+    argv = _fill(command, files) + [x for pair in pairs for x in pair
+                                    if not (pair[0] == "--scheduler" and ":" in x)]
+    code, err = outcome(argv, capsys)
+    assert code in ("accepted", 0, cli.EXIT_BAD_INPUT), (argv, code, err)
     if code == cli.EXIT_BAD_INPUT:
         assert len(err.strip().splitlines()) == 1, err

@@ -311,10 +311,10 @@ def _check_scheduler(address: str) -> None:
     text = address if "://" in address else f"tcp://{address}"
     try:
         url = urlsplit(text)
-        host, port = url.hostname, url.port
+        scheme, host, port = url.scheme, url.hostname, url.port
     except ValueError:
-        host, port = None, None
-    if url.scheme not in ("tcp", "tls") or not host or not port:
+        scheme, host, port = None, None, None
+    if scheme not in ("tcp", "tls") or not host or not port:
         raise ParameterError(f"--scheduler {address}: expects a Dask scheduler address "
                              "tcp://HOST:PORT")
     try:

@@ -171,7 +171,7 @@ def _unfinished(study: Study, out: Path):
     chains = study.chains()
     keys = [chain_keys(study, c) for c in chains]
     todo = [(c, k) for c, k in zip(chains, keys)
-            if not all((out / "points" / f"{key}.parquet").exists() for key in k)]
+            if not all(read_point(out / "points" / f"{key}.parquet") is not None for key in k)]
     return keys, todo
 
 
