@@ -394,7 +394,7 @@ def _project_rows(y, offset, set_index, stick, rows, held, P, free, cg, cw):
     return worst
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw):
     """Two Newton steps of the positions onto the active (and held) gaps; geometry refilled.
 
