@@ -99,15 +99,17 @@ def stability_limit(p: Parameters) -> float:
 
 def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: float | None,
                    output_hz: float, t0: float = 0.0, names: dict | None = None,
-                   stability: bool = True) -> tuple[float, int, int]:
+                   strict: bool = True) -> tuple[float, int, int]:
     """Check a run's settings against what its step can resolve; return (dt, decim, n_steps).
 
-    The step (given or :func:`default_dt`) must be RK4-stable for the model
-    (``stability``; :func:`stability_limit`), resolve the drive
+    The step (given or :func:`default_dt`) must resolve the drive
     (STEPS_PER_PERIOD steps per period of a sine or a chirp's highest
     frequency, MIN_PULSE_STEPS per hammer pulse) and divide the output
-    interval and the duration; a hammer hit and a soft-start ramp must end
-    within the run.  ``names`` maps the setting names (duration, dt,
+    interval and the duration.  ``strict`` (the command line and studies)
+    adds: the step RK4-stable for the model (:func:`stability_limit`), a
+    hammer hit and a soft-start ramp ending within the run.  The Python API
+    (:func:`simulate`) is not strict: a short look at a run's start, or a
+    deliberately unstable step in a test, stays possible.  ``names`` maps the setting names (duration, dt,
     output_hz, freq_hz, f0_hz, f1_hz, width_s, t_hit_s, ramp_s) to the
     names the user wrote (an option, a study key), for the messages.
     Raises ParameterError.
@@ -128,7 +130,7 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
         if not MIN_DT <= dt <= MAX_DT:
             raise ParameterError(f"{name('dt')} = {dt:g} s is outside the allowed range "
                                  f"[{MIN_DT:g}, {MAX_DT:g}] s")
-        if stability:
+        if strict:
             limit = stability_limit(params)
             if dt > limit:
                 raise ParameterError(
@@ -159,7 +161,7 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
                 raise ParameterError(
                     f"{name(key)} = {ex[col]:g} Hz is above what the step dt = {dt:g} s resolves "
                     f"({STEPS_PER_PERIOD} steps per period: at most {f_max:g} Hz)")
-    if kind in (ly.EXC_SINE, ly.EXC_CHIRP) and ex[ly.X_RAMP] > end:
+    if strict and kind in (ly.EXC_SINE, ly.EXC_CHIRP) and ex[ly.X_RAMP] > end:
         raise ParameterError(f"{name('ramp_s')} = {ex[ly.X_RAMP]:g} s: the soft start would "
                              f"end after the run ({end:g} s)")
     if kind in (ly.EXC_HAMMER_JOINT, ly.EXC_HAMMER_TIP):
@@ -168,7 +170,7 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
             raise ParameterError(f"{name('width_s')} = {width:g} s is shorter than "
                                  f"{MIN_PULSE_STEPS} steps dt = {dt:g} s: the step cannot "
                                  "resolve the pulse (give a smaller dt or leave it out)")
-        if ex[ly.X_T_HIT] + width > end:
+        if strict and ex[ly.X_T_HIT] + width > end:
             raise ParameterError(f"{name('t_hit_s')} = {ex[ly.X_T_HIT]:g} s: the pulse of "
                                  f"{width:g} s would end after the run ({end:g} s)")
     return dt, decim, n_steps
@@ -375,7 +377,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if ex.shape != (ly.N_EXC,):
         raise ParameterError("excitation must come from workbench.excitation (an array of "
                              f"{ly.N_EXC} values)")
-    dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, stability=False)
+    dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, strict=False)
     if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
         raise ParameterError("free_decay_cm releases the structure without excitation; "
                              "leave excitation unset")

@@ -320,7 +320,7 @@ def _check_point(point: Point, duration, dt, output_hz, where) -> None:
         raise StudyError(f"[study] dt = {dt:g} s is above the RK4 stability limit "
                          f"{stability_limit(point.params):.3g} s of the model at "
                          f"{_short(point.values)}; give at most that, or leave dt out")
-    check_settings(point.params, ex, duration, dt, output_hz, names=where, stability=False)
+    check_settings(point.params, ex, duration, dt, output_hz, names=where)
 
 
 def _stepped(points, sweep):
