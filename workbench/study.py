@@ -308,7 +308,7 @@ def _value_key(value):
 
 def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     """A point's excitation values, and its run settings against what the step resolves."""
-    from .simulate import check_settings, stability_limit
+    from .simulate import check_settings
     ex = point.excitation_array()                  # validates the excitation values
     if point.excitation["kind"] == "free_decay":
         x = point.excitation.get("deflection_cm")
@@ -316,10 +316,6 @@ def _check_point(point: Point, duration, dt, output_hz, where) -> None:
         if not ok or abs(x) > FREE_DECAY_MAX_CM:
             raise StudyError(f"{where['deflection_cm']} = {_short(x)} cm is outside the allowed "
                              f"range [-{FREE_DECAY_MAX_CM:g}, {FREE_DECAY_MAX_CM:g}] cm")
-    if dt is not None and dt > stability_limit(point.params):
-        raise StudyError(f"[study] dt = {dt:g} s is above the RK4 stability limit "
-                         f"{stability_limit(point.params):.3g} s of the model at "
-                         f"{_short(point.values)}; give at most that, or leave dt out")
     check_settings(point.params, ex, duration, dt, output_hz, names=where)
 
 
