@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 from workbench import cli
 from workbench import expfiles as F
@@ -307,6 +307,7 @@ def test_fuzzed_parameter_files_never_crash(data, tmp_path_factory, capsys):
 
 @settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
 @given(cut=st.integers(0, 2000), junk=st.binary(max_size=16))
+@example(cut=64, junk=b"\n")                  # a header key left without its value
 def test_fuzzed_experiment_files_never_crash(cut, junk, files, capsys):
     text = Path(files["R"]).read_bytes()
     path = Path(files["R"]).with_name("damaged.lvm")

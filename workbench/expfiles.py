@@ -152,14 +152,14 @@ def read_lvm(path, strain_scale: dict | None = None) -> pd.DataFrame:
         raise ExperimentFileError(path, 1, "not a LabVIEW measurement file (the first line must "
                                   "be 'LabVIEW Measurement')")
     i, header = _header_block(path, lines, 1, "\t")
-    sep = {"Tab": "\t", "Comma": ",", "Semicolon": ";", "Space": " "}.get(
-        header.get("Separator", ["Tab"])[0])
+    separator = _text_field(path, header, "Separator", "Tab")
+    sep = {"Tab": "\t", "Comma": ",", "Semicolon": ";", "Space": " "}.get(separator)
     if sep is None:
-        raise ExperimentFileError(path, None, f"Separator {header['Separator'][0]!r} is not supported")
+        raise ExperimentFileError(path, None, f"Separator {separator!r} is not supported")
     if sep != "\t":
         i, header = _header_block(path, lines, 1, sep)
-    decimal = header.get("Decimal_Separator", ["."])[0]
-    x_columns = header.get("X_Columns", ["One"])[0]
+    decimal = _text_field(path, header, "Decimal_Separator", ".")
+    x_columns = _text_field(path, header, "X_Columns", "One")
     if x_columns not in ("No", "One"):
         raise ExperimentFileError(path, None, f"X_Columns {x_columns!r} is not supported "
                                   "(use No or One: the channels share one time base)")
@@ -248,6 +248,15 @@ def _header_block(path, lines, i, sep) -> tuple[int, dict[str, list[str]]]:
             header[key] = [c.strip() for c in cells[1:]]
         i += 1
     raise ExperimentFileError(path, start + 1, f"header without {END_OF_HEADER} (truncated file?)")
+
+
+def _text_field(path, header, key, default: str) -> str:
+    """The first value of a header key; ``default`` if the key is absent, an error if it is empty."""
+    if key not in header:
+        return default
+    if not header[key] or not header[key][0]:
+        raise ExperimentFileError(path, None, f"the header line '{key}' has no value")
+    return header[key][0]
 
 
 def _int_field(path, line, seg, key) -> int:
