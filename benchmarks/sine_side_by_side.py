@@ -8,7 +8,8 @@ Run it alternately in two checkouts to compare commits side by side, e.g.
       python benchmarks/sine_side_by_side.py 20 3
     done
 
-Arguments: force (N), runs; ``--locked`` holds the joint (no contact events).
+Arguments: force (N), runs; ``--locked`` holds the joint (no contact events),
+``--no-tip`` takes the tip mass off.
 Prints one JSON line: the wall times (s, simulation only), status, events.
 """
 import json
@@ -22,16 +23,17 @@ from workbench.simulate import simulate
 def main(argv):
     force, runs = float(argv[0]), int(argv[1])
     locked = "--locked" in argv
+    tip = "--no-tip" not in argv
     kw = dict(fixed=model.JOINT, initial="paper") if locked else {}
-    p = Parameters(cork="cubic", tip_mass=True).replace(gap_mm=1.016)
+    p = Parameters(cork="cubic", tip_mass=tip).replace(gap_mm=1.016)
     ex = excitation.sine(force, 20.0, ramp_s=1.0)
     simulate(p, ex, 0.2, **kw)                      # compile / load the cache
     walls = []
     for _ in range(runs):
         run = simulate(p, ex, 10.0, **kw)
         walls.append(run.wall_s)
-    print(json.dumps({"force_n": force, "locked": locked, "walls": walls, "status": run.status,
-                      "events": int(len(run.events))}))
+    print(json.dumps({"force_n": force, "locked": locked, "tip_mass": tip, "dt": run.dt,
+                      "walls": walls, "status": run.status, "events": int(len(run.events))}))
 
 
 if __name__ == "__main__":

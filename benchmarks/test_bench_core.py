@@ -7,8 +7,9 @@
   contact and double contact, sticking and sliding;
 * a 10 s free-flight run at dt = 5e-5 s (joint locked: without contact the
   loose body would fly through the plates), 200 000 RK4 steps;
-* the issue-3 run: 10 s sine, 1.016 mm gap, 20 Hz, tip mass, cubic cork, at
-  the default step and the default force, with contact and events.
+* the issue-3 run: 10 s sine, 1.016 mm gap, 20 Hz, cubic cork, with and
+  without the tip mass, at the default step and the default force, with
+  contact and events.
 """
 import numpy as np
 import pytest
@@ -70,12 +71,14 @@ def test_free_flight_10s(benchmark):
     assert tr.status == 0 and len(tr.t) == 10001
 
 
-def test_contact_sine_10s(benchmark):
-    p = Parameters().replace(gap_mm=1.016, tip_mass=True, cork="cubic")
+@pytest.mark.parametrize("tip", [True, False], ids=["tip", "no-tip"])
+def test_contact_sine_10s(benchmark, tip):
+    p = Parameters().replace(gap_mm=1.016, tip_mass=tip, cork="cubic")
     ex = sine(DEFAULT_FORCE_N, 20.0, ramp_s=1.0)
     simulate(p, ex, 0.01)                                  # compile / load cache
     run = benchmark.pedantic(simulate, args=(p, ex, 10.0), rounds=3, iterations=1)
     s = run.summary()
     benchmark.extra_info.update({k: s[k] for k in ("n_events", "n_impacts", "dt",
                                                    "energy_balance_rel", "max_penetration_cm")})
+    benchmark.extra_info["tip_mass"] = tip
     assert run.ok
