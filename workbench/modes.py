@@ -13,6 +13,8 @@ stiffness and give rigid-body modes at 0 Hz.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.linalg
 
@@ -78,8 +80,11 @@ def _check_conditioned(M, K, joint) -> None:
                              "a mass or length is out of scale")
 
 
+@functools.lru_cache(maxsize=256)
 def linear_eigenvalues(p: Parameters) -> np.ndarray:
     """Eigenvalues (1/s) of the damped linear system, joint free and locked (concatenated).
+
+    Computed once per parameter set (the array is read-only).
 
     They set the explicit integrator's step (:func:`workbench.simulate.default_dt`):
     the fastest are the beams' axial modes, damped at their own zeta
@@ -98,5 +103,7 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
         out.append(np.linalg.eigvals(A))
-    return np.concatenate(out)
+    lam = np.concatenate(out)
+    lam.flags.writeable = False
+    return lam
 

@@ -13,7 +13,6 @@ Units are CGS (MODEL.md); ``run.units`` names them per column.
 """
 from __future__ import annotations
 
-import functools
 import sys
 import time
 from dataclasses import dataclass, field
@@ -71,13 +70,9 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
     return NICE_STEPS[-1]
 
 
-@functools.lru_cache(maxsize=256)
 def _eigenvalues(p: Parameters) -> np.ndarray:
-    """:func:`workbench.modes.linear_eigenvalues`, once per parameter set (read-only)."""
-    from .modes import linear_eigenvalues
-    lam = linear_eigenvalues(p)
-    lam.flags.writeable = False
-    return lam
+    from .modes import linear_eigenvalues         # scipy.linalg: imported when first needed
+    return linear_eigenvalues(p)
 
 
 def stability_limit(p: Parameters) -> float:
