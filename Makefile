@@ -33,7 +33,7 @@ bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmark
 
 # The studies of `make study` (studies/<name>.toml -> results/<name>/report.md).
 STUDIES := free_decay stepped chirp shaker
-SOURCES := $(wildcard workbench/*.py workbench/core/*.py)
+SOURCES := $(shell find workbench -name "*.py" -not -path "*/__pycache__/*")
 
 study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, modes, identification, estimator)
 
@@ -54,7 +54,7 @@ $(RESULTS)/modes/modes.md: $(STAMP) studies/modes.py $(SOURCES)
 	$(PY) studies/modes.py --out $(RESULTS)/modes
 
 # The paper's Tables 3-6 and Appendix B reproduced (issue 5).
-$(RESULTS)/identification/identification.md: $(STAMP) $(SOURCES) $(wildcard workbench/identify/*.py)
+$(RESULTS)/identification/identification.md: $(STAMP) $(SOURCES)
 	$(PY) -m workbench identify tables --out $(RESULTS)/identification
 
 # The parameter estimator on synthetic .lvm records with hidden values (issue 5).

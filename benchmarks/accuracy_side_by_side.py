@@ -25,9 +25,9 @@ import time
 
 import numpy as np
 
-from workbench.excitation import chirp, sine
-from workbench.params import Parameters
-from workbench.simulate import simulate
+from workbench.model.excitation import chirp, sine
+from workbench.model.params import Parameters
+from workbench.model.simulate import simulate
 
 SAMPLE_HZ = 1000.0
 CONVERGED_DT = 3.125e-6

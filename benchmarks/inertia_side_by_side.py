@@ -13,11 +13,11 @@ import time
 import numba as nb
 import numpy as np
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.dynamics import assemble_inertia
 from workbench.core.kinematics import compute_frames, element, n_elements
-from workbench.params import Parameters
+from workbench.model.params import Parameters
 
 
 @nb.njit(inline="always")

@@ -14,13 +14,13 @@ import time
 import numba as nb
 import numpy as np
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import rhs_regime
 from workbench.core.dynamics import add_applied_forces, assemble_inertia, factor_free, rhs
 from workbench.core.integrate import rk4_step
-from workbench.excitation import sine
-from workbench.params import Parameters
+from workbench.model.excitation import sine
+from workbench.model.params import Parameters
 
 PARTS = ("mass matrix, h, gravity", "applied forces", "Cholesky of M", "rhs (free flight)",
          "rhs_regime", "RK4 step")

@@ -19,11 +19,11 @@ import numpy as np
 import pandas as pd
 
 from workbench.core import layout as ly
-from workbench.excitation import chirp, sine
-from workbench.metrics import contact_shares
-from workbench.params import Parameters
+from workbench.model.excitation import chirp, sine
+from workbench.study.metrics import contact_shares
+from workbench.model.params import Parameters
 from workbench.reference import HybridReference, Regime, shaker
-from workbench.simulate import simulate
+from workbench.model.simulate import simulate
 
 #: Sample rate of the windows' tip height (Hz).
 SAMPLE_HZ = 1000.0

@@ -15,9 +15,9 @@ Prints one JSON line: the wall times (s, simulation only), status, events.
 import json
 import sys
 
-from workbench import excitation, model
-from workbench.params import Parameters
-from workbench.simulate import simulate
+from workbench.model import excitation, packing as model
+from workbench.model.params import Parameters
+from workbench.model.simulate import simulate
 
 
 def main(argv):

@@ -19,9 +19,9 @@ ROOT = Path(__file__).resolve().parents[1]
 FIRST_RUN = """
 import json, time
 t0 = time.perf_counter()
-from workbench.excitation import DEFAULT_FORCE_N, sine
-from workbench.params import Parameters
-from workbench.simulate import simulate
+from workbench.model.excitation import DEFAULT_FORCE_N, sine
+from workbench.model.params import Parameters
+from workbench.model.simulate import simulate
 t1 = time.perf_counter()
 run = simulate(Parameters().replace(gap_mm=1.016, tip_mass=True, cork="cubic"),
                sine(DEFAULT_FORCE_N, 20.0, ramp_s=1.0), 10.0)

@@ -14,12 +14,12 @@
 import numpy as np
 import pytest
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
-from workbench.excitation import DEFAULT_FORCE_N, sine
-from workbench.freeflight import integrate
-from workbench.params import Parameters
-from workbench.simulate import simulate
+from workbench.model.excitation import DEFAULT_FORCE_N, sine
+from workbench.model.freeflight import integrate
+from workbench.model.params import Parameters
+from workbench.model.simulate import simulate
 
 from rhs_parts import RHS, RHS_REGIME, repeat
 

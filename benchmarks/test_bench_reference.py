@@ -16,7 +16,7 @@ import pytest
 
 from side_by_side import (CHIRP, CONVERGED_DT, SINE, full_run, kernel_window, reference_window,
                           window_start)
-from workbench.simulate import default_dt
+from workbench.model.simulate import default_dt
 
 KERNEL_STEPS = (1.25e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5, 6.25e-6)
 LSODA_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)

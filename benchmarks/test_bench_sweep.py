@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from workbench import study as S
-from workbench.sweep import run_study
+from workbench.study import definition as S
+from workbench.study.sweep import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
 SCALING_DURATION_S = 2.0

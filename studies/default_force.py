@@ -16,9 +16,9 @@ import argparse
 import json
 from pathlib import Path
 
-from workbench import excitation
-from workbench.params import Parameters
-from workbench.simulate import simulate
+from workbench.model import excitation
+from workbench.model.params import Parameters
+from workbench.model.simulate import simulate
 
 FREQS = [10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
 

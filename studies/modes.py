@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from workbench.modes import natural_frequencies
-from workbench.params import CORK_MODELS, Parameters
-from workbench.provenance import environment
+from workbench.model.modes import natural_frequencies
+from workbench.model.params import CORK_MODELS, Parameters
+from workbench.study.provenance import environment
 
 N_MODES = 6
 

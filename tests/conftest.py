@@ -7,7 +7,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))   # tests/fe_reference.py
 
-from workbench.params import Parameters  # noqa: E402
+from workbench.model.params import Parameters  # noqa: E402
 
 #: Typical magnitudes of (w_A, phi_A, u_A, s, v, psi, w_B, phi_B, u_B) for
 #: random states: centimetres of deflection, tenths of a radian.

@@ -20,7 +20,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 from workbench import cli
-from workbench import expfiles as F
+from workbench.experiments import files as F
 
 
 class WouldRun(BaseException):
@@ -33,14 +33,14 @@ def _stub(*args, **kwargs):
 
 @pytest.fixture(autouse=True)
 def no_work(monkeypatch, tmp_path):
-    import workbench.compare
-    import workbench.estimate
-    import workbench.simulate
-    import workbench.sweep
-    monkeypatch.setattr(workbench.simulate, "simulate", _stub)
-    monkeypatch.setattr(workbench.sweep, "run_study", _stub)
-    monkeypatch.setattr(workbench.estimate, "estimate", _stub)
-    monkeypatch.setattr(workbench.compare, "compare", _stub)
+    import workbench.experiments.compare
+    import workbench.experiments.estimate
+    import workbench.model.simulate
+    import workbench.study.sweep
+    monkeypatch.setattr(workbench.model.simulate, "simulate", _stub)
+    monkeypatch.setattr(workbench.study.sweep, "run_study", _stub)
+    monkeypatch.setattr(workbench.experiments.estimate, "estimate", _stub)
+    monkeypatch.setattr(workbench.experiments.compare, "compare", _stub)
     monkeypatch.setenv("WORKBENCH_CRASH_DIR", str(tmp_path / "crash"))
     monkeypatch.chdir(tmp_path)
 

@@ -6,11 +6,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench import expfiles as F
+from workbench.experiments import files as F
 from workbench.cli import main
-from workbench.estimate import estimate
-from workbench.matching import setup_from
-from workbench.params import ParameterError
+from workbench.experiments.estimate import estimate
+from workbench.experiments.matching import setup_from
+from workbench.model.params import ParameterError
 
 HIDDEN = {"e_b": 6.0e11, "force_n": 14.0}
 SETTINGS = {"drive": "sine", "freq_hz": 25.0, "ramp_s": 0.5, "gap_mm": 1.016}

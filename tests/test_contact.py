@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.contact import eval_geometry
-from workbench.params import Parameters
+from workbench.model.params import Parameters
 
 COLS = (ly.CG_DS, ly.CG_DV, ly.CG_DPSI)
 HESS = {(0, 0): ly.CG_HSS, (0, 1): ly.CG_HSV, (0, 2): ly.CG_HSP, (1, 1): ly.CG_HVV,

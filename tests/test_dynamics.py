@@ -10,12 +10,12 @@ import pytest
 from conftest import random_state
 from workbench.reference import Reference
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.dynamics import energies, eval_inertia, eval_rhs
-from workbench.excitation import sine
-from workbench.freeflight import integrate
-from workbench.params import ParameterError, Parameters
+from workbench.model.excitation import sine
+from workbench.model.freeflight import integrate
+from workbench.model.params import ParameterError, Parameters
 
 #: A conservative configuration: no damping, no forcing, no contact; the
 #: joint coordinates free but held by springs (linear cork on s, k_v, k_psi).

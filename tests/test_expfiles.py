@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 from hypothesis import HealthCheck, example, given, settings, strategies as st
 
-from workbench import expfiles as F
+from workbench.experiments import files as F
 
 
 def _record(n=50, seed=0):

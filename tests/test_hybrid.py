@@ -11,17 +11,16 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings, strategies as st
 
-from workbench import excitation as X
-from workbench import model as mdl
+from workbench.model import excitation as X
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import kinetic_energy, rhs_regime
 from workbench.core.contact import eval_geometry
 from workbench.core.transitions import GAP_TOL, impact
-from workbench.params import ParameterError, Parameters
-from workbench.simulate import (MAX_DEFAULT_DT, NICE_STEPS, STABILITY_MARGIN, contact_code,
-                                default_dt, regime_name, rk4_amplification, simulate)
-from workbench.modes import linear_eigenvalues
-from workbench.statics import static_equilibrium
+from workbench.model.params import ParameterError, Parameters
+from workbench.model.simulate import (MAX_DEFAULT_DT, NICE_STEPS, STABILITY_MARGIN, contact_code, default_dt, regime_name, rk4_amplification, simulate)
+from workbench.model.modes import linear_eigenvalues
+from workbench.model.statics import static_equilibrium
 
 ALL = set(ly.COORD_NAMES)
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from conftest import random_state
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.kinematics import element_kinematics
 from workbench.core.shapes import fill_shape_row
-from workbench.params import Parameters
+from workbench.model.params import Parameters
 
 
 def kinematics(model, q, qd):

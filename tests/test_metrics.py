@@ -1,9 +1,9 @@
-"""Metrics of one run (workbench.metrics) on signals with known answers."""
+"""Metrics of one run (workbench.study.metrics) on signals with known answers."""
 import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.metrics import contact_shares, harmonic_amplitudes, once_per_period, regime_time
+from workbench.study.metrics import (contact_shares, harmonic_amplitudes, once_per_period, regime_time)
 
 
 def test_harmonic_amplitudes_recover_a_known_mixture():

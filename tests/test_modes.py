@@ -7,12 +7,12 @@ import pytest
 import scipy.linalg
 from fe_reference import cantilever_frequencies, locked_frequencies
 
-from workbench import model as mdl
+from workbench.model import packing as mdl
 from workbench.cli import main
 from workbench.core import layout as ly
 from workbench.core.dynamics import eval_inertia
-from workbench.modes import natural_frequencies
-from workbench.params import Parameters
+from workbench.model.modes import natural_frequencies
+from workbench.model.params import Parameters
 
 BETA1_L = 1.875104    # first root of cos(bL) cosh(bL) = -1 (Blevins, Formulas for
                       # Natural Frequency and Mode Shape, Table 8-1)

@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from workbench.params import CORK_MODELS, FIELDS, ParameterError, Parameters, describe
+from workbench.model.params import CORK_MODELS, FIELDS, ParameterError, Parameters, describe
 
 
 def test_defaults_are_the_model_md_values():

@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 from workbench.core.excitation import shaker_force
-from workbench.excitation import chirp, sine
+from workbench.model.excitation import chirp, sine
 from workbench.reference import HybridReference, shaker
 from workbench.core import layout as ly
-from workbench.params import Parameters
-from workbench.simulate import simulate
+from workbench.model.params import Parameters
+from workbench.model.simulate import simulate
 
 HORIZON = 0.036
 KERNEL_DT = 1.25e-5

@@ -10,11 +10,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench import study as S
-from workbench import sweep as W
-from workbench.report import make_report
-from workbench.params import ParameterError
-from workbench.store import read_runs
+from workbench.study import definition as S
+from workbench.study import sweep as W
+from workbench.present.report import make_report
+from workbench.model.params import ParameterError
+from workbench.study.store import read_runs
 
 SMALL = """
 [study]
@@ -307,7 +307,7 @@ def test_an_interrupted_sweep_is_on_record(small_run, tmp_path, monkeypatch):
 
 
 def test_a_second_sweep_of_the_same_study_is_refused(small_run, tmp_path):
-    from workbench.store import StudyLock
+    from workbench.study.store import StudyLock
     study, _, _ = small_run
     out = tmp_path / "res" / "small"
     with StudyLock(out):

@@ -9,15 +9,15 @@ end in finished runs with every impact dissipative.
 import numpy as np
 import pytest
 
-from workbench import excitation as X
-from workbench import model as mdl
+from workbench.model import excitation as X
+from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import kinetic_energy
 from workbench.core.dynamics import cork_energy, cork_force, eval_inertia
 from workbench.core.transitions import moreau_jean_step
-from workbench.modes import linear_eigenvalues
-from workbench.params import ParameterError, Parameters
-from workbench.simulate import CONTACT_STAT_KEYS, simulate
+from workbench.model.modes import linear_eigenvalues
+from workbench.model.params import ParameterError, Parameters
+from workbench.model.simulate import CONTACT_STAT_KEYS, simulate
 
 
 @pytest.mark.parametrize("cork", ["none", "linear", "cubic"])

@@ -30,10 +30,9 @@ import traceback
 from pathlib import Path
 
 from . import __version__
-from .params import CORK_MODELS, ParameterError, Parameters, describe
-from .paths import check_output_dir, check_output_file
-from .limits import (FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N,
-                     MAX_OUTPUT_HZ, MIN_DT)
+from .model.params import CORK_MODELS, ParameterError, Parameters, describe
+from .study.paths import check_output_dir, check_output_file
+from .model.limits import (FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MAX_OUTPUT_HZ, MIN_DT)
 
 EXIT_OK = 0
 EXIT_RUN_FAILED = 1
@@ -133,7 +132,7 @@ def _parameters(args) -> Parameters:
     the user wrote; a parameter given twice (``--set cork=linear --cork
     none``) is refused.
     """
-    from .params import resolve_name
+    from .model.params import resolve_name
     base = _given(f"--params {args.params}", Parameters.from_toml, args.params) \
         if args.params else Parameters()
     given = [(f"--set {_cut(name)}={_cut(text)}", name, _value(text))
@@ -175,12 +174,12 @@ def _parameters(args) -> Parameters:
 
 def check_model(p: Parameters) -> None:
     """The linear model of p is usable (finite, positive definite, conditioned), or ParameterError."""
-    from .modes import linear_eigenvalues
+    from .model.modes import linear_eigenvalues
     linear_eigenvalues(p)
 
 
 def _cmd_modes(args) -> int:
-    from .modes import natural_frequencies
+    from .model.modes import natural_frequencies
     p = _parameters(args)
     freqs = natural_frequencies(p, args.joint)
     if args.json:
@@ -206,7 +205,7 @@ def _chirp(text: str) -> tuple[float, float, float]:
 
 
 def _excitation(args):
-    from . import excitation as X
+    from .model import excitation as X
     force = X.DEFAULT_FORCE_N if args.force_n is None else args.force_n
     if args.force_n is not None and args.force_n < 0 and args.impulse is None:
         raise ParameterError(f"--force-n {args.force_n:g}: a shaker amplitude must be >= 0 N "
@@ -224,14 +223,14 @@ def _excitation(args):
     return None
 
 
-#: The run options behind the names of :func:`workbench.simulate.check_settings`.
+#: The run options behind the names of :func:`workbench.model.simulate.check_settings`.
 RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--output-hz",
                     "freq_hz": "--freq-hz", "f0_hz": "--chirp F0", "f1_hz": "--chirp F1",
                     "width_s": "--pulse-s", "t_hit_s": "--hit-s", "ramp_s": "--ramp-s"}
 
 
 def _cmd_run(args) -> int:
-    from .simulate import check_settings, simulate
+    from .model.simulate import check_settings, simulate
     n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse))
     if n_drives > 1:
         raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse")
@@ -258,7 +257,7 @@ def _cmd_run(args) -> int:
 
 
 def _excitation_none():
-    from .excitation import none
+    from .model.excitation import none
     return none()
 
 
@@ -281,8 +280,8 @@ def _cmd_params(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from .study import load
-    from .sweep import plan, run_study
+    from .study.definition import load
+    from .study.sweep import plan, run_study
 
     study = load(args.study)
     check_output_dir("--results", args.results)
@@ -298,7 +297,7 @@ def _cmd_sweep(args) -> int:
                "status": {str(k): int(v) for k, v in counts.items()},
                "results": str(Path(args.results) / study.name)}
     if not args.no_report:
-        from .report import make_report
+        from .present.report import make_report
         summary["report"] = str(make_report(study, args.results))
     print(json_text(summary))
     return EXIT_OK if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
@@ -325,8 +324,8 @@ def _check_scheduler(address: str) -> None:
 
 
 def _cmd_report(args) -> int:
-    from .report import make_report
-    from .study import load
+    from .present.report import make_report
+    from .study.definition import load
 
     study = load(args.study)
     if not (Path(args.results) / study.name / "points.parquet").is_file():
@@ -357,7 +356,7 @@ def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") ->
 
 def _record_settings(args, meta: dict) -> dict:
     """A record's settings (matching.py): the file's, overridden by the command line."""
-    from .study import ALL_EXCITATION_KEYS
+    from .study.definition import ALL_EXCITATION_KEYS
 
     settings = dict(meta)
     given = {"gap_mm": args.gap_mm, "tip_mass": args.tip_mass, "cork": args.cork}
@@ -398,7 +397,7 @@ def _pair_numbers(items, option, what, lo=None, lo_open=False) -> dict[str, floa
 
 
 def _read_record(args, path):
-    from .expfiles import read
+    from .experiments.files import read
     scale = _pair_numbers(args.strain_scale, "--strain-scale", "STRAIN_PER_VOLT", 0, lo_open=True)
     return read(path, strain_scale={name.lower(): value for name, value in scale.items()})
 
@@ -427,10 +426,10 @@ def _check_window(path, record, skip_s: float) -> None:
 
 
 def _cmd_compare(args) -> int:
-    from .compare import compare
-    from .matching import setup_from
+    from .experiments.compare import compare
+    from .experiments.matching import setup_from
 
-    from .compare import SIGNALS
+    from .experiments.compare import SIGNALS
     record = _read_record(args, args.file)
     _check_window(args.file, record, args.skip_s)
     if not any(c in record.columns for c in SIGNALS):
@@ -452,10 +451,10 @@ def _cmd_compare(args) -> int:
 
 
 def _cmd_estimate(args) -> int:
-    from .estimate import estimate
-    from .matching import setup_from
+    from .experiments.estimate import estimate
+    from .experiments.matching import setup_from
 
-    from .estimate import FITTABLE
+    from .experiments.estimate import FITTABLE
     start = _pair_numbers(args.fit, "--fit", "START", 0, lo_open=True)
     unknown = sorted(set(start) - set(FITTABLE))
     if unknown:

@@ -3,7 +3,7 @@
 numba's ``cache=True`` checks only the timestamp of the file that defines a
 function.  A kernel that calls a jit function of another module keeps the
 callee's machine code compiled into its own cache entry, and so does a
-global constant read from :mod:`workbench.config`: change the callee or the
+global constant read from :mod:`workbench.core.config`: change the callee or the
 constant, and the caller silently runs the old code.  (Measured: after the
 double-contact friction changed in constrained.py, the cached rk4_step kept
 the old friction and a slip phase drifted 6e-4 cm/s off the new equations.)
@@ -25,7 +25,7 @@ from pathlib import Path
 from numba.core import caching
 
 _CORE = Path(__file__).resolve().parent
-_SOURCES = sorted(_CORE.glob("*.py")) + [_CORE.parent / "config.py"]
+_SOURCES = sorted(_CORE.glob("*.py"))           # the kernels and their config.py
 _PREFIX = "numba-"
 
 

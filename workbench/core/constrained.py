@@ -33,7 +33,7 @@ their rates onto the active rows.
 """
 import numba as nb
 
-from ..config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS
+from .config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
 from .dynamics import rhs, solve_factored

@@ -27,7 +27,7 @@ import math
 
 import numba as nb
 
-from ..config import JIT, JIT_INLINE
+from .config import JIT, JIT_INLINE
 from . import layout as ly
 
 

@@ -7,7 +7,7 @@ with Q the elastic, damping, gravity, cork and shaker forces.  Coordinates
 not in ``free`` are held fixed: their rows are dropped and their
 accelerations are zero (their velocities must be zero too).
 
-Argument convention of every kernel here (see :mod:`workbench.model`):
+Argument convention of every kernel here (see :mod:`workbench.model.packing`):
 ``P, tab, kc, free`` describe the model, ``ex`` the excitation, and
 ``rec, mat, vec`` are scratch.  All functions are jit-compiled; those that
 can fail return a status code of :mod:`workbench.core.layout`.
@@ -16,7 +16,7 @@ import math
 
 import numba as nb
 
-from ..config import CHOLESKY_REL_PIVOT, JIT, JIT_INLINE
+from .config import CHOLESKY_REL_PIVOT, JIT, JIT_INLINE
 from . import layout as ly
 from .excitation import hammer_force, shaker_force
 from .inertia import frame_sums
@@ -30,7 +30,7 @@ def fill_stiffness_damping(P, kc):
     Per beam: bending EI/L^3 [[12, -6L], [-6L, 4L^2]] on (w, phi) and axial
     EA/L on u (exact for the Hermite shapes); damping C_b = beta K_b on the
     bending block and the axial coordinate's own damping c_ax on u
-    (:meth:`workbench.params.Parameters.axial_damping`).  The optional
+    (:meth:`workbench.model.params.Parameters.axial_damping`).  The optional
     springs k_v, k_psi on the loose body (0 in the paper's model) are
     undamped.
     """

@@ -8,7 +8,7 @@ Integrated by RK4 with ``substeps`` steps per record sample.
 import numba as nb
 import numpy as np
 
-from ..config import JIT, JIT_INLINE, JIT_PARALLEL
+from .config import JIT, JIT_INLINE, JIT_PARALLEL
 from .dynamics import cork_spring
 from .layout import ERR_NAN, OK
 

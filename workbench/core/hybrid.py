@@ -39,16 +39,14 @@ samples and the log written so far.
 """
 import numba as nb
 
-from ..config import (EVENT_TIME_TOL, JIT, JIT_INLINE, LAMBDA_EPS,
-                      MAX_EVENTS_PER_STEP, RATE_EPS)
+from .config import EVENT_TIME_TOL, JIT, JIT_INLINE, LAMBDA_EPS, MAX_EVENTS_PER_STEP, RATE_EPS
 from . import layout as ly
 from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
 from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
 from .dynamics import rhs
 from .integrate import rk4_step
 from .sensors import fill_signals
-from .transitions import (ACCUM_GAP_TOL, CLOSED_RATE, GAP_TOL, choose_regime, impact,
-                          moreau_jean_step)
+from .transitions import (ACCUM_GAP_TOL, CLOSED_RATE, GAP_TOL, choose_regime, impact, moreau_jean_step)
 
 #: Impacts recurring within this many steps, or closing slower than the gap's
 #: free acceleration makes in this many steps, are an accumulation (MODEL.md §7).

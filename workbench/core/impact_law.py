@@ -28,7 +28,7 @@ beta-, and the slip speed) is solved by Lemke's complementary pivoting.
 import numba as nb
 import numpy as np
 
-from ..config import JIT, JIT_INLINE
+from .config import JIT, JIT_INLINE
 from . import layout as ly
 
 OPEN, STICK, SLIP_POS, SLIP_NEG = 0, 1, 2, 3

@@ -23,7 +23,7 @@ independent reference).
 """
 import numba as nb
 
-from ..config import JIT_INLINE
+from .config import JIT_INLINE
 from . import layout as ly
 from .kinematics import beam_point_local, tip_row
 

@@ -13,7 +13,7 @@ import math
 
 import numba as nb
 
-from ..config import JIT, JIT_INLINE
+from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .constrained import rhs_regime
 

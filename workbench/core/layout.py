@@ -21,7 +21,7 @@ COORD_NAMES = ("w_A", "phi_A", "u_A", "s", "v", "psi", "w_B", "phi_B", "u_B")
 COORD_UNITS = ("cm", "rad", "cm", "cm", "cm", "rad", "cm", "rad", "cm")
 
 # --- the flat parameter array P (CGS) ----------------------------------------
-# Built by workbench.model.pack from a validated workbench.params.Parameters.
+# Built by workbench.model.packing.pack from a validated workbench.model.params.Parameters.
 P_L_A = 0        # beam A length (cm)
 P_L_B = 1        # beam B length (cm)
 P_MU_A = 2       # beam A mass per length (g/cm)

@@ -15,7 +15,7 @@ import math
 
 import numba as nb
 
-from ..config import JIT, JIT_INLINE
+from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .constrained import kinetic_energy
 from .contact import fill_geometry, regime_of

@@ -19,7 +19,7 @@ stiffness of a cubic beam element.
 """
 import numba as nb
 
-from ..config import JIT
+from .config import JIT
 from . import layout as ly
 
 

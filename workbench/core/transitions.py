@@ -27,10 +27,9 @@ import math
 
 import numba as nb
 
-from ..config import GAP_EPS, JIT, JIT_INLINE, LAMBDA_EPS
+from .config import GAP_EPS, JIT, JIT_INLINE, LAMBDA_EPS
 from . import layout as ly
-from .constrained import (add_contact_forces, fill_delassus, kinetic_energy, project, rhs_regime,
-                          stick_margin, stick_tolerance, tangent_point, _put_row)
+from .constrained import (add_contact_forces, fill_delassus, kinetic_energy, project, rhs_regime, stick_margin, stick_tolerance, tangent_point, _put_row)
 from .contact import fill_geometry, in_set, row_convective, row_rate, set_of
 from .dynamics import rhs
 from .impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, solve_impact

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..params import ParameterError
+from ..model.params import ParameterError
 
 #: The contact channels, in point order (Table 2).
 PATCHES = ("contact1", "contact2", "contact3", "contact4")

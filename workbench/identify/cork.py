@@ -36,7 +36,7 @@ import numpy as np
 
 from ..core import layout as ly
 from ..core.hammer import hammer_response, hammer_scores
-from ..params import CORK_MODELS, ParameterError, Parameters, check_positive
+from ..model.params import CORK_MODELS, ParameterError, Parameters, check_positive
 
 #: Spring exponent of each law the paper fitted (Table 6).
 CORK_LAWS = {"linear": 1.0, "quadratic": 2.0, "cubic": 3.0}

@@ -31,8 +31,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..metrics import parabolic_vertex
-from ..params import ParameterError, check_positive
+from ..study.metrics import parabolic_vertex
+from ..model.params import ParameterError, check_positive
 
 #: Eq. 2's factor: E I = EI_FACTOR mu omega_n^2 L^4.
 EI_FACTOR = 11.0 / 140.0

@@ -7,7 +7,7 @@
 """
 from __future__ import annotations
 
-from ..params import check_positive
+from ..model.params import check_positive
 
 
 def parallel_axis(i_cm: float, mass: float, distance: float) -> float:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import ParameterError, check_positive
+from ..model.params import ParameterError, check_positive
 
 
 def euler_double_integral(t: np.ndarray, accel: np.ndarray, detrend: bool = True) -> np.ndarray:

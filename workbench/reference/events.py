@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.linalg import null_space
 
-from ..config import FRICTION_REL_EPS, GAP_EPS, LAMBDA_EPS, RATE_EPS
+from ..core.config import FRICTION_REL_EPS, GAP_EPS, LAMBDA_EPS, RATE_EPS
 from ..core.impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, eval_impact
 from ..core.transitions import CLOSED_RATE, GAP_TOL, REGIME_REL_TOL, REST_RATE
 from .equations import N, Jet, Reference, jcos, jsin

@@ -1,6 +1,6 @@
 """Figures of a study (issue 4), in the style of the paper's §6, as PNG and PDF.
 
-From the points table (one row per grid point, :mod:`workbench.sweep`):
+From the points table (one row per grid point, :mod:`workbench.study.sweep`):
 
 - :func:`frf_maps`            tip RMS over gap x frequency, a panel per other axis value
 - :func:`response_curves`     tip RMS against frequency, a line per gap
@@ -31,8 +31,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from scipy import signal as sps  # noqa: E402
 
-from .metrics import CONTACT_CODES, QUANTITIES, psd  # noqa: E402
-from .points import label, panels  # noqa: E402
+from ..study.metrics import CONTACT_CODES, QUANTITIES, psd  # noqa: E402
+from ..study.grid import label, panels  # noqa: E402
 
 CODE_COLORS = dict(zip(CONTACT_CODES, plt.get_cmap("tab10").colors))
 SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
@@ -205,7 +205,7 @@ def strain_spectra(signals: pd.DataFrame, title: str, seconds: float | None = No
 
 def switching_diagram(events: pd.DataFrame, t_end: float, title: str, seconds: float = 0.5):
     """The contact code against time over the last ``seconds`` (paper Fig. 9)."""
-    from .simulate import contact_code
+    from ..model.simulate import contact_code
 
     t0 = t_end - seconds
     t = events.t.to_numpy()

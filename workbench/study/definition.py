@@ -42,9 +42,9 @@ from typing import Any
 
 import numpy as np
 
-from . import excitation as X
-from .limits import FREE_DECAY_MAX_CM, MAX_NAME_CHARS
-from .params import ParameterError, Parameters, check_positive, read_toml, resolve_name
+from ..model import excitation as X
+from ..model.limits import FREE_DECAY_MAX_CM, MAX_NAME_CHARS
+from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 #: Excitation kinds and the keys each accepts (user units in the names).
 EXCITATION_KEYS = {
@@ -308,7 +308,7 @@ def _value_key(value):
 
 def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     """A point's excitation values, and its run settings against what the step resolves."""
-    from .simulate import check_settings
+    from ..model.simulate import check_settings
     ex = point.excitation_array()                  # validates the excitation values
     if point.excitation["kind"] == "free_decay":
         x = point.excitation.get("deflection_cm")

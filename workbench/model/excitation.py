@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from .core import layout as ly
+from ..core import layout as ly
 from .params import ParameterError, check_positive
 
 #: dyn per newton

@@ -20,12 +20,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from . import model as mdl
-from .core import layout as ly
-from .core.hybrid import run_hybrid
+from . import packing as mdl
+from ..core import layout as ly
+from ..core.hybrid import run_hybrid
 from .excitation import none
 from .limits import MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD
-from .metrics import contact_shares
+from ..study.metrics import contact_shares
 from .params import ParameterError, Parameters, check_positive
 from .statics import static_equilibrium, tip_load_for_deflection
 
@@ -53,7 +53,7 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
     """The largest step of NICE_STEPS (at most MAX_DEFAULT_DT) at which RK4 is stable.
 
     Stable: |R(STABILITY_MARGIN lambda dt)| <= 1 for every eigenvalue lambda
-    of :func:`workbench.modes.linear_eigenvalues`.  With the tip mass this
+    of :func:`workbench.model.modes.linear_eigenvalues`.  With the tip mass this
     is 1e-4 s (the fastest mode, -246 +- 2.05e4 j 1/s); without it 5e-5 s
     (-321 +- 3.54e4 j 1/s): the beams' lightly damped axial modes, near the
     imaginary axis where RK4 is stable to |lambda dt| = 2.83.  A hammer
@@ -71,7 +71,7 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
 
 
 def _eigenvalues(p: Parameters) -> np.ndarray:
-    from .modes import linear_eigenvalues         # scipy.linalg: imported when first needed
+    from .modes import linear_eigenvalues  # scipy.linalg: imported when first needed
     return linear_eigenvalues(p)
 
 
@@ -356,7 +356,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
              t0: float = 0.0, regime: int = 0) -> Run:
     """Simulate ``duration`` seconds of the loose-joint beam (MODEL.md §3-9).
 
-    ``excitation`` is an array from :mod:`workbench.excitation` (default: none).
+    ``excitation`` is an array from :mod:`workbench.model.excitation` (default: none).
     ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
     excitation is evaluated at those times (e.g. to continue from a state
     of an earlier run, given as ``initial`` with its ``regime``).
@@ -367,10 +367,10 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     with a status code and keeps what it computed.
     """
     if not isinstance(params, Parameters):
-        raise ParameterError(f"params must be workbench.params.Parameters, got {type(params).__name__}")
+        raise ParameterError(f"params must be workbench.model.params.Parameters, got {type(params).__name__}")
     ex = none() if excitation is None else np.asarray(excitation, dtype=float)
     if ex.shape != (ly.N_EXC,):
-        raise ParameterError("excitation must come from workbench.excitation (an array of "
+        raise ParameterError("excitation must come from workbench.model.excitation (an array of "
                              f"{ly.N_EXC} values)")
     dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, strict=False)
     if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
@@ -449,7 +449,7 @@ def compile_kernel(args) -> float:
     import numba
     if run_hybrid.signatures:
         return 0.0
-    from .core._cache import CACHE_DIR
+    from ..core._cache import CACHE_DIR
     if not any(CACHE_DIR.glob("hybrid.run_hybrid-*.nbi")):
         print(f"workbench: compiling the numba kernels ({COMPILE_NOTE}; once, then cached in "
               f"{CACHE_DIR})", file=sys.stderr, flush=True)

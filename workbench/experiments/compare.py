@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .expfiles import CHANNELS, kind, record_from_run
-from .identify.contacts import PATCHES, contact_code_series
-from .metrics import CONTACT_CODES, psd, spectral_peaks
+from .files import CHANNELS, kind, record_from_run
+from ..identify.contacts import PATCHES, contact_code_series
+from ..study.metrics import CONTACT_CODES, psd, spectral_peaks
 
 #: Channels compared as signals (the contact patches are compared as codes).
 SIGNALS = tuple(c for c in CHANNELS if kind(c) != "contact")
@@ -110,7 +110,7 @@ def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
             threshold=DEFAULT_THRESHOLD_V, seconds: float = 0.5, chirp: bool = False,
             title: str = "") -> Comparison:
     """Compare ``record`` with a simulated ``run`` and write figures and tables into ``out``."""
-    from . import figures as F
+    from ..present import figures as F
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

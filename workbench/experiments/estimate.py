@@ -34,10 +34,10 @@ import numpy as np
 import pandas as pd
 
 from .compare import SIGNALS, code_series, code_shares, window
-from .expfiles import record_from_run
+from .files import record_from_run
 from .matching import Setup
-from .metrics import CONTACT_CODES, psd
-from .params import ParameterError
+from ..study.metrics import CONTACT_CODES, psd
+from ..model.params import ParameterError
 
 #: What can be fitted: name -> (where it lives, lower, upper bound).  "param" is a
 #: field of Parameters (CGS), "mu" sets mu_s = mu_k, "excitation" a drive setting (N).

@@ -1,15 +1,15 @@
 """The ranges of run settings accepted at the user boundary (command line, studies, API).
 
-Physical parameters carry their ranges in :mod:`workbench.params`; these
+Physical parameters carry their ranges in :mod:`workbench.model.params`; these
 are the settings of a run.  What a given step resolves (drive frequency,
 pulse width) is checked against the step by
-:func:`workbench.simulate.check_settings`.
+:func:`workbench.model.simulate.check_settings`.
 """
 #: The longest run (s) and the shortest step (s).
 MAX_DURATION_S = 1e5
 MIN_DT = 1e-7
 #: The largest step (s): RK4 is unstable far below it for this model; the
-#: model's own limit is :func:`workbench.simulate.stability_limit`.
+#: model's own limit is :func:`workbench.model.simulate.stability_limit`.
 MAX_DT = 1e-3
 #: The largest sample rate of the stored signals (Hz).
 MAX_OUTPUT_HZ = 1e6

@@ -32,12 +32,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .core import layout as ly
+from ..core import layout as ly
 from .metrics import contact_checks, point_metrics
 from .provenance import code_version
-from .simulate import default_dt, simulate
+from ..model.simulate import default_dt, simulate
 from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
-from .study import Point, Study
+from .definition import Point, Study
 
 #: Wall seconds per RK4 step assumed by :func:`plan` when the study has no
 #: run log yet (a contact-rich 10 s point at 1e-4 s takes ~1-2 s).

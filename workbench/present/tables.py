@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from .metrics import CONTACT_CODES, QUANTITIES
-from .points import label, panels
+from ..study.metrics import CONTACT_CODES, QUANTITIES
+from ..study.grid import label, panels
 
 TABLES = {
     "response": {k: QUANTITIES[k] for k in ("tip_rms", "tip_h1", "strain1_rms", "accel3_rms")},

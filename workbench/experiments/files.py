@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .params import ParameterError
+from ..model.params import ParameterError
 
 #: Table 2's sensor names, as the files write them, by workbench channel.
 TABLE2_NAMES = {"force1": "Force1", "strain1": "Strain1", "accel1": "Accel1",

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import model as mdl
-from .core import layout as ly
-from .core.integrate import integrate_fixed
+from . import packing as mdl
+from ..core import layout as ly
+from ..core.integrate import integrate_fixed
 from .excitation import none
 from .params import ParameterError
 

@@ -22,10 +22,10 @@ from pathlib import Path
 import pandas as pd
 
 from . import figures as F
-from .points import point_title
-from .provenance import environment
-from .store import read_runs, write_text_atomic
-from .study import Study
+from ..study.grid import point_title
+from ..study.provenance import environment
+from ..study.store import read_runs, write_text_atomic
+from ..study.definition import Study
 from .tables import write_tables
 
 

@@ -28,11 +28,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import model as mdl
-from .core import layout as ly
-from .core.contact import eval_geometry
-from .core.dynamics import energies, eval_rhs
-from .core.kinematics import element_kinematics
+from . import packing as mdl
+from ..core import layout as ly
+from ..core.contact import eval_geometry
+from ..core.dynamics import energies, eval_rhs
+from ..core.kinematics import element_kinematics
 from .excitation import DYN_PER_N, none
 from .params import ParameterError, Parameters
 
@@ -193,7 +193,7 @@ def static_equilibrium(p: Parameters, tip_load_n: float = 0.0, fixed=(), s0: flo
     equilibrium.
     """
     if not isinstance(p, Parameters):
-        raise ParameterError(f"expected workbench.params.Parameters, got {type(p).__name__}")
+        raise ParameterError(f"expected workbench.model.params.Parameters, got {type(p).__name__}")
     if not np.isfinite(tip_load_n):
         raise ParameterError(f"tip_load_n = {tip_load_n!r} N must be finite")
     if q_guess is None:     # the common case (every simulate call): solved once per process

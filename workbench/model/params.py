@@ -10,7 +10,7 @@ lost); they are ordinary, overridable parameters, flagged in
 
 Example::
 
-    >>> from workbench.params import Parameters
+    >>> from workbench.model.params import Parameters
     >>> p = Parameters(cork="linear").replace(gap_mm=0.508)
     >>> round(p.gap, 4)
     0.0508

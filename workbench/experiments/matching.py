@@ -1,8 +1,8 @@
 """The simulation that matches a record: its model parameters, excitation and length.
 
-A record's settings come from its file (``WB_`` keys, :mod:`workbench.expfiles`)
+A record's settings come from its file (``WB_`` keys, :mod:`workbench.experiments.files`)
 and from the command line, which wins.  The keys are those of a study
-(:mod:`workbench.study`): ``drive`` (the excitation kind: sine, chirp,
+(:mod:`workbench.study.definition`): ``drive`` (the excitation kind: sine, chirp,
 free_decay, hammer_joint, hammer_tip, none) with its settings (``freq_hz``,
 ``force_n``, ``ramp_s``, ``f0_hz``, ``f1_hz``, ``sweep_s``,
 ``deflection_cm``, ``width_s``, ``t_hit_s``), and any model parameter of
@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .params import ParameterError, Parameters, resolve_name
-from .study import EXCITATION_DEFAULTS, EXCITATION_KEYS, excitation_array
+from ..model.params import ParameterError, Parameters, resolve_name
+from ..study.definition import EXCITATION_DEFAULTS, EXCITATION_KEYS, excitation_array
 
 
 @dataclass(frozen=True)
@@ -31,7 +31,7 @@ class Setup:
 
     def simulate(self, params: Parameters | None = None, excitation: dict | None = None):
         """Run it (optionally with other parameters or excitation settings)."""
-        from .simulate import simulate
+        from ..model.simulate import simulate
 
         exc = excitation or self.excitation
         free = exc.get("deflection_cm") if exc["kind"] == "free_decay" else None

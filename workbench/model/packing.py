@@ -1,4 +1,4 @@
-"""Pack validated :class:`~workbench.params.Parameters` into kernel arrays.
+"""Pack validated :class:`~workbench.model.params.Parameters` into kernel arrays.
 
 The kernels see a few flat arrays whose layout is declared in
 :mod:`workbench.core.layout`.  Python code carries them as two named tuples,
@@ -21,9 +21,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from .core import layout as ly
-from .core.dynamics import fill_stiffness_damping
-from .core.shapes import fill_shape_row
+from ..core import layout as ly
+from ..core.dynamics import fill_stiffness_damping
+from ..core.shapes import fill_shape_row
 from .params import ParameterError, Parameters
 
 #: The loose joint's coordinates; ``fixed=JOINT`` locks the joint.
@@ -104,7 +104,7 @@ def shape_table(p: Parameters) -> np.ndarray:
 def build(p: Parameters, fixed: Iterable[str | int] = ()) -> Model:
     """The kernel-side model of parameters ``p`` with ``fixed`` coordinates held."""
     if not isinstance(p, Parameters):
-        raise ParameterError(f"expected workbench.params.Parameters, got {type(p).__name__}")
+        raise ParameterError(f"expected workbench.model.params.Parameters, got {type(p).__name__}")
     held = {coordinate_index(c) for c in fixed}
     free = np.array([i for i in range(ly.N_DOF) if i not in held], dtype=np.int64)
     if free.size == 0:

@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from .core import layout as ly
+from ..core import layout as ly
 
 CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
 HARMONICS = (0.5, 1.0, 2.0, 3.0)
@@ -136,7 +136,7 @@ def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
 
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
                   steady_tol: float = STEADY_TOL) -> dict:
-    """The metrics of the module docstring for a finished :class:`~workbench.simulate.Run`."""
+    """The metrics of the module docstring for a finished :class:`~workbench.model.simulate.Run`."""
     sig = run.signals
     t = sig.index.to_numpy()
     t_end = float(t[-1])
@@ -205,7 +205,7 @@ def contact_checks(run) -> dict:
 
     Forces and speeds are read from the stored signals (the output rate).
     """
-    from .simulate import CONTACT_STAT_KEYS
+    from ..model.simulate import CONTACT_STAT_KEYS
     p = run.params
     out = {key: run.stats[key] for key in CONTACT_STAT_KEYS}
     e_kin = float(run.signals.e_kin.max()) if len(run.signals) else 0.0

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .params import ParameterError
+from ..model.params import ParameterError
 
 
 def write_atomic(df: pd.DataFrame, path: Path) -> None:

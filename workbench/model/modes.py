@@ -18,9 +18,9 @@ import functools
 import numpy as np
 import scipy.linalg
 
-from . import model as mdl
-from .core import layout as ly
-from .core.dynamics import eval_inertia
+from . import packing as mdl
+from ..core import layout as ly
+from ..core.dynamics import eval_inertia
 from .params import ParameterError, Parameters
 
 
@@ -86,7 +86,7 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
 
     Computed once per parameter set (the array is read-only).
 
-    They set the explicit integrator's step (:func:`workbench.simulate.default_dt`):
+    They set the explicit integrator's step (:func:`workbench.model.simulate.default_dt`):
     the fastest are the beams' axial modes, damped at their own zeta
     (MODEL.md §5): -246 +- 2.05e4 j 1/s with the tip mass, -321 +- 3.54e4 j
     without.

@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .params import ParameterError
+from ..model.params import ParameterError
 
 
 def _name_max(folder: Path) -> int:

@@ -1,0 +1,1 @@
+"""Experiments: record files, matching, comparison, parameter estimation."""

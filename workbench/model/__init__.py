@@ -1,0 +1,1 @@
+"""The model: parameters, drives, packing for the kernels, runs, statics, modes."""

@@ -1,0 +1,1 @@
+"""Studies: definitions, grids, sweeps, stored results, metrics, provenance."""
