@@ -26,10 +26,10 @@ test: $(STAMP)  ## run the test suite (physics checks included)
 	$(PY) -m pytest -q
 
 # About 20 minutes: the paper's method (LSODA) runs on windows, the default grid twice.
-bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in README
+bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md
 	$(PY) -m pytest -q benchmarks --benchmark-only --benchmark-enable --benchmark-autosave \
 		--benchmark-columns=min,median,max,rounds -p no:randomly
-	$(PY) benchmarks/summarise.py --out benchmarks/results.md --readme README.md
+	$(PY) benchmarks/summarise.py --out benchmarks/results.md --readme docs/performance.md
 
 # The studies of `make study` (studies/<name>.toml -> results/<name>/report.md).
 STUDIES := free_decay stepped chirp shaker

@@ -1,4 +1,4 @@
-"""The workbench against the paper's method on the same windows of the same runs (issue 6).
+"""The workbench against the paper's method on the same windows of the same runs.
 
 The reference (:mod:`workbench.reference`: the same equations in NumPy,
 LSODA, restarts at every event) costs milliseconds per right-hand side, so
@@ -33,7 +33,7 @@ CONVERGED_DT = 3.125e-6
 
 @dataclass(frozen=True)
 class Case:
-    """A benchmark run: 1.016 mm gap, tip mass, cubic cork (issue 6)."""
+    """A benchmark run: 1.016 mm gap, tip mass, cubic cork."""
 
     name: str
     force_n: float
@@ -53,9 +53,9 @@ class Case:
         return sine(self.force_n, 20.0, ramp_s=1.0)
 
 
-#: The issue-3 run: 20 N (the default force), 20 Hz, 10 s.
+#: The benchmark run: 20 N, 20 Hz, 10 s.
 SINE = Case("sine 10 s", 20.0, 10.0, window_at_s=5.0, window_s=0.25)
-#: The chirp at 10 N: at 20 N the study's chirps stop early (README "Known limits").
+#: The chirp: 10 N, 5-65 Hz over 240 s (seed §5.5).
 CHIRP = Case("chirp 240 s", 10.0, 240.0, window_at_s=120.0, window_s=0.25, chirp=True)
 
 

@@ -1,9 +1,9 @@
-"""Tables of the newest ``make bench`` JSON (pytest-benchmark autosave) for README "Performance".
+"""Tables of the newest ``make bench`` JSON (pytest-benchmark autosave) for docs/performance.md.
 
-    python benchmarks/summarise.py [--json FILE] [--readme README.md] [--out FILE]
+    python benchmarks/summarise.py [--json FILE] [--readme docs/performance.md] [--out FILE]
 
 Prints Markdown; ``--out`` writes it to a file; ``--readme`` replaces the
-part of the README between the markers ``<!-- bench:start -->`` and
+part of that file between the markers ``<!-- bench:start -->`` and
 ``<!-- bench:end -->``.  Every figure is a median of the saved rounds.  Each
 benchmark is taken from the newest saved run that has it (a partial run,
 ``pytest benchmarks/test_bench_reference.py ...``, updates its tables only);

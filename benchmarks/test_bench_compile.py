@@ -1,7 +1,7 @@
-"""Compilation: the first run in a fresh process, with and without numba's cache (issue 6).
+"""Compilation: the first run in a fresh process, with and without numba's cache.
 
 Each round starts a new Python process that imports the workbench and
-simulates the issue-3 run (10 s sine, 1.016 mm, 20 Hz, tip mass, cubic
+simulates the benchmark run (10 s sine, 1.016 mm, 20 Hz, tip mass, cubic
 cork).  "cold": the kernels' cache folder (WORKBENCH_CACHE_ROOT) is empty,
 so numba compiles everything; "warm": the same folder again, so the
 kernels are loaded from it.  The benchmark times the whole process; the

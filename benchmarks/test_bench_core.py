@@ -7,7 +7,7 @@
   contact and double contact, sticking and sliding;
 * a 10 s free-flight run at dt = 5e-5 s (joint locked: without contact the
   loose body would fly through the plates), 200 000 RK4 steps;
-* the issue-3 run: 10 s sine, 1.016 mm gap, 20 Hz, cubic cork, with and
+* the benchmark run: 10 s sine, 1.016 mm gap, 20 Hz, cubic cork, with and
   without the tip mass, at the default step and the default force, with
   contact and events.
 """

@@ -1,7 +1,7 @@
-"""The workbench against the paper's method, and accuracy against cost (issue 6).
+"""The workbench against the paper's method, and accuracy against cost.
 
 Run by ``make bench``; ``benchmarks/summarise.py`` turns the saved JSON into
-the tables of README "Performance".  Everything here runs in one process,
+the tables of docs/performance.md.  Everything here runs in one process,
 side by side, so that the ratios share the machine's load of the moment.
 
 * the 10 s sine run and the 240 s chirp, whole, at the default step;

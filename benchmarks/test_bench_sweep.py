@@ -1,4 +1,4 @@
-"""Benchmarks of the sweep runner (issues 4 and 6); never part of pass/fail.
+"""Benchmarks of the sweep runner; never part of pass/fail.
 
 * scaling: the default study's grid (studies/shaker.toml: 240 points, 4 gaps
   x 10 frequencies x tip mass on/off x 3 cork models) with 1 and 2 worker

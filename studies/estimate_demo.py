@@ -1,4 +1,4 @@
-"""The parameter estimator demonstrated (issue 5; seed §7.2): a synthetic experiment
+"""The parameter estimator demonstrated (seed §7.2): a synthetic experiment
 with hidden parameters is fitted and the values are recovered.
 
     python studies/estimate_demo.py --out results/estimate

@@ -1,4 +1,4 @@
-"""Comparison with experiments and the parameter estimator (issue 5), end to end
+"""Comparison with experiments and the parameter estimator, end to end
 through a simulated record written as a LabVIEW file."""
 import json
 

@@ -1,4 +1,4 @@
-"""Experiment files (issue 5): round trips, units, and damaged files that must fail
+"""Experiment files: round trips, units, and damaged files that must fail
 with an error naming the file and the line, never with a traceback or wrong data."""
 import numpy as np
 import pandas as pd

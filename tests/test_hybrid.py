@@ -1,4 +1,4 @@
-"""Contact, impacts, stick/slip and events (MODEL.md §7-9; issue 3).
+"""Contact, impacts, stick/slip and events (docs/model.md §7-9).
 
 Closed-form cases hold coordinates fixed (model.build(fixed=...)):
   * the loose assembly falling across the gap (only v moves),

@@ -1,4 +1,4 @@
-"""Parameter identification (issue 5): the paper's tables, the decrement, the cork
+"""Parameter identification: the paper's tables, the decrement, the cork
 fit, the strain calibration and the PVDF contact detection."""
 import math
 

@@ -1,4 +1,4 @@
-"""Studies and sweeps (issue 4): definition -> parallel, resumable runs -> points table."""
+"""Studies and sweeps: definition -> parallel, resumable runs -> points table."""
 import os
 import signal
 import subprocess

@@ -348,7 +348,7 @@ def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") ->
     drive.add_argument("--impulse", choices=("joint", "tip"),
                        help="half-sine hammer: vertical at the joint body, or axial at the tip")
     drive.add_argument("--force-n", type=_number(-MAX_FORCE_N, MAX_FORCE_N),
-                       help="shaker amplitude or hammer peak (N); default: see README")
+                       help="shaker amplitude or hammer peak (N); default: see docs/usage.md")
     drive.add_argument("--ramp-s", type=_number(0), help=ramp_help)
     drive.add_argument("--pulse-s", type=_number(0, lo_open=True), default=1e-3, help="hammer pulse duration (s)")
     drive.add_argument("--hit-s", type=_number(0), default=0.01, help="hammer pulse start (s)")

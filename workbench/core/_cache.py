@@ -8,8 +8,8 @@ constant, and the caller silently runs the old code.  (Measured: after the
 double-contact friction changed in constrained.py, the cached rk4_step kept
 the old friction and a slip phase drifted 6e-4 cm/s off the new equations.)
 
-This module keys the cache by a hash of all kernel sources and of
-config.py: the kernels of ``workbench.core`` are cached under
+This module keys the cache by a hash of all kernel sources (config.py
+included): the kernels of ``workbench.core`` are cached under
 ``__pycache__/numba-<hash>/``, so any change to any of them compiles
 everything afresh, and entries of other versions are removed.  The
 environment variable ``WORKBENCH_CACHE_ROOT`` puts the ``numba-<hash>``

@@ -17,7 +17,7 @@ DYN_PER_N = 1.0e5
 
 #: Default shaker amplitude (N): the tip stays below the paper's 8.4 cm
 #: deflection across 10-55 Hz at the widest gap with the tip mass (chosen by
-#: studies/default_force.py; see README "Default shaker amplitude").
+#: studies/default_force.py; see docs/usage.md, "Default shaker amplitude").
 DEFAULT_FORCE_N = 200.0
 #: Default hammer peak (N).
 DEFAULT_HAMMER_N = 100.0

@@ -1,6 +1,6 @@
 """Free-flight integration from Python: validate, allocate, call the kernel.
 
-Contact is not modelled here (issue 3): the loose body moves freely through
+Contact is not modelled here: the loose body moves freely through
 the plates, so use it with the joint locked or held by springs, or for
 short checks.  Returns the decimated trajectory and the kernel's status.
 """

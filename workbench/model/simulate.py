@@ -35,9 +35,9 @@ NICE_STEPS = (1e-4, 5e-5, 4e-5, 2.5e-5, 2e-5, 1e-5, 5e-6)
 #: :func:`default_dt` asks RK4 to be stable for every eigenvalue of the
 #: linear model scaled by this factor: room for the stiffening of contact.
 STABILITY_MARGIN = 1.25
-#: The largest default step (s): the accuracy study of issue 6 (README
-#: "Performance") finds the tip height within ~1e-6 of its range and the
-#: contact time shares within ~1e-8 of a converged run at 1e-4 s.
+#: The largest default step (s): on the benchmark windows at 1e-4 s the tip
+#: height is within 2.6e-5 of its range and the contact time shares within
+#: 5e-6 of a converged run (docs/performance.md).
 MAX_DEFAULT_DT = 1e-4
 #: Steps per hammer pulse at least (the pulse's half-sine and its ends).
 PULSE_STEPS = 20
@@ -435,7 +435,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     return run
 
 
-#: What the first compile of the kernels takes (README "Install"), for the message.
+#: What the first compile of the kernels takes (README "Two commands"), for the message.
 COMPILE_NOTE = "about 8 minutes on 2 cores"
 
 

@@ -1,4 +1,4 @@
-"""Figures of a study (issue 4), in the style of the paper's §6, as PNG and PDF.
+"""Figures of a study, in the style of the paper's §6, as PNG and PDF.
 
 From the points table (one row per grid point, :mod:`workbench.study.sweep`):
 

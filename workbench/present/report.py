@@ -1,4 +1,4 @@
-"""A study's report (issue 4): figures, tables, an index and the provenance.
+"""A study's report: figures, tables, an index and the provenance.
 
     results/<study>/figures/*.png, *.pdf
     results/<study>/tables/{response,contact}.{csv,md,tex}

@@ -1,4 +1,4 @@
-"""Paper-style tables of a study (issue 4): CSV, Markdown and LaTeX.
+"""Paper-style tables of a study: CSV, Markdown and LaTeX.
 
 Two tables, each per gap x drive frequency with a block per value of the
 other axes (tip mass, cork, ...):

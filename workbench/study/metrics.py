@@ -1,4 +1,4 @@
-"""Scalar results of one run over its steady-state window (issue 4).
+"""Scalar results of one run over its steady-state window.
 
 The window is the last ``window_s`` seconds of the run.  Per sensor channel
 (force1, strain1, strain2, accel1-3) and for the tip displacement from its

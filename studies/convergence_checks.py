@@ -1,5 +1,5 @@
-"""Measurements quoted for issue 3: step convergence through events, energy balance,
-penetration and drift, and the 10 s benchmark run.  python studies/issue3_checks.py"""
+"""Measurements quoted in docs/verification.md: step convergence through events, energy balance,
+penetration and drift, and the 10 s benchmark run.  python studies/convergence_checks.py"""
 import numpy as np
 from workbench.model.params import Parameters
 from workbench.model.simulate import simulate
