@@ -46,8 +46,8 @@ def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
             status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                                  ydot)
         else:
-            status |= rk4_step(1e-3 * i, y, 1e-5, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
-                               rg, stages, stages[ly.STAGE_NEXT])
+            status |= rk4_step(1e-3 * i, y, 1e-5, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+                               cw, rg, stages[ly.STAGE_NEXT])
     return status
 
 

@@ -22,6 +22,7 @@ from workbench.core import layout as ly
 from workbench.model.excitation import chirp, sine
 from workbench.study.metrics import contact_shares
 from workbench.model.params import Parameters
+from workbench.model.regimes import is_stick, set_of
 from workbench.reference import HybridReference, Regime, shaker
 from workbench.model.simulate import simulate
 
@@ -127,7 +128,7 @@ def reference_window(case: Case, t0: float, y0: np.ndarray, regime: int, rtol: f
     n = round(case.window_s * SAMPLE_HZ)
     t_eval = t0 + np.arange(n + 1) / SAMPLE_HZ
     start = time.perf_counter()
-    start_regime = Regime((regime + 1) // 2, regime % 2 == 1)
+    start_regime = Regime(set_of(regime), is_stick(regime))
     out = ref.run(t0, t0 + case.window_s, y0, start_regime, max_events=10**6, t_eval=t_eval)
     wall = time.perf_counter() - start
     tip = np.array([ref.model.tip_y(y[:ly.N_DOF]) for y in out.samples])

@@ -48,7 +48,7 @@ REGIMES = {"free": (0, False), "single-stick": (1, True), "single-slip": (1, Fal
 
 @pytest.mark.parametrize("regime", list(REGIMES))
 def test_rhs_regime_evaluation(benchmark, regime):
-    """rhs_regime: the equations, the contact rows and their 1-3 multipliers (MODEL.md §7)."""
+    """rhs_regime: the equations, the contact rows and their 1-3 multipliers (docs/model.md §7)."""
     model, work = mdl.build(Parameters()), mdl.make_work()
     set_index, stick = REGIMES[regime]
     work.rg[ly.RG_SET], work.rg[ly.RG_STICK], work.rg[ly.RG_SIGN] = set_index, float(stick), 1.0

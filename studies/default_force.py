@@ -1,6 +1,6 @@
 """How the default shaker amplitude is chosen.
 
-The paper drove the shaker at 0.4-0.8 V and gives no force (MODEL.md §8).
+The paper drove the shaker at 0.4-0.8 V and gives no force (docs/model.md §8).
 The rule: the largest candidate force, within the range the stress study
 validates (up to 200 N, studies/stress.toml), for which the tip stays below
 the paper's 8.4 cm deflection (seed §5.3) across 10-55 Hz at the widest gap

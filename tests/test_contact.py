@@ -1,4 +1,4 @@
-"""Contact geometry (MODEL.md §7): hand-derived derivatives against finite differences."""
+"""Contact geometry (docs/model.md §7): hand-derived derivatives against finite differences."""
 import numpy as np
 import pytest
 
@@ -43,7 +43,7 @@ def test_gaps_at_rest_and_rocking_closure():
     P = mdl.pack(p)
     cg = _geom(P, np.zeros(ly.N_DOF))
     np.testing.assert_allclose(cg[ly.CG_G:ly.CG_G + 4, ly.CG_VAL], p.gap / 2, rtol=1e-12)
-    # MODEL.md: with v = -gap/2, point 4 closes at psi ~ gap / D
+    # docs/model.md: with v = -gap/2, point 4 closes at psi ~ gap / D
     q = np.zeros(ly.N_DOF)
     q[ly.V] = -p.gap / 2
     D = p.x_lip - p.x_in

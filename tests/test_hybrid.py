@@ -16,9 +16,12 @@ from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import kinetic_energy, rhs_regime
 from workbench.core.contact import eval_geometry
-from workbench.core.transitions import GAP_TOL, impact
+from workbench.core.config import GAP_TOL
+from workbench.core.transitions import impact
 from workbench.model.params import ParameterError, Parameters
-from workbench.model.simulate import (MAX_DEFAULT_DT, NICE_STEPS, STABILITY_MARGIN, contact_code, default_dt, regime_name, rk4_amplification, simulate)
+from workbench.model.regimes import contact_code, regime_name
+from workbench.model.simulate import (MAX_DEFAULT_DT, NICE_STEPS, STABILITY_MARGIN, default_dt,
+                                      rk4_amplification, simulate)
 from workbench.model.modes import linear_eigenvalues
 from workbench.model.statics import static_equilibrium
 
@@ -156,7 +159,7 @@ def test_static_equilibrium_is_balanced_and_admissible():
         assert np.all(eq.lambda_n >= 0)
         assert eq.friction_held
         if tip:
-            assert eq.contact_code == 23               # MODEL.md §8: pried into {2, 3}
+            assert eq.contact_code == 23               # docs/model.md §8: pried into {2, 3}
         assert eq.tip_y < -1.0                         # it sags by centimetres
         again = static_equilibrium(p)                 # solved once per process, then copied
         assert again is not eq and np.array_equal(again.q, eq.q)

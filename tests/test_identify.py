@@ -6,7 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.identify import (calibrate_patch, cantilever_strain, decrement_from_record, detect_contacts, contact_code_series, euler_double_integral, fit_cork, hammer_record, hooke_stiffness, log_decrement, parallel_axis)
+from workbench.identify import (calibrate_patch, cantilever_strain, decrement_from_record,
+                                detect_contacts, contact_code_series, euler_double_integral,
+                                fit_cork, hammer_record, hooke_stiffness, log_decrement,
+                                parallel_axis)
 from workbench.identify import paper as P
 from workbench.identify import tables as T
 from workbench.model.params import ParameterError

@@ -13,7 +13,8 @@ import pytest
 from hypothesis import example, assume, given, settings, strategies as st
 
 from workbench.core import layout as ly
-from workbench.core.impact_law import (FOUND_ENUMERATION, NOT_FOUND, OPEN, SLIP_NEG, SLIP_POS, STICK, energy_change, eval_impact, lemke_impact)
+from workbench.core.impact_law import (FOUND_ENUMERATION, NOT_FOUND, OPEN, SLIP_NEG, SLIP_POS,
+                                       STICK, energy_change, eval_impact, lemke_impact)
 
 
 def delassus(W, Minv):

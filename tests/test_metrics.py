@@ -3,7 +3,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.study.metrics import (contact_shares, harmonic_amplitudes, once_per_period, regime_time)
+from workbench.study.metrics import (contact_shares, harmonic_amplitudes, once_per_period,
+                                     regime_time)
 
 
 def test_harmonic_amplitudes_recover_a_known_mixture():

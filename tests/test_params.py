@@ -1,4 +1,4 @@
-"""Parameters: every MODEL.md number with its source, validation, units, TOML."""
+"""Parameters: every docs/model.md number with its source, validation, units, TOML."""
 import math
 
 import pytest
@@ -8,7 +8,7 @@ from workbench.model.params import CORK_MODELS, FIELDS, ParameterError, Paramete
 
 def test_defaults_are_the_model_md_values():
     p = Parameters()
-    # MODEL.md §2 (Tables 3, 4, Appendix B) and §6 (Table 6)
+    # docs/model.md §2 (Tables 3, 4, Appendix B) and §6 (Table 6)
     assert (p.rho, p.mu_a, p.rho_i_a, p.m3, p.i3, p.m4, p.i4, p.m6, p.i6) == (
         2.5065, 4.0428, 0.03396, 313.81, 6973.4, 123.33, 1398.6, 158.9, 301.55)
     assert p.cork_law == (3.0, 1.0e4, 1.7e4)
@@ -17,7 +17,7 @@ def test_defaults_are_the_model_md_values():
 
 def test_derived_section_matches_the_bar():
     p = Parameters()
-    # I = b h^3 / 12 for a 2 in x 1/8 in bar (MODEL.md §2)
+    # I = b h^3 / 12 for a 2 in x 1/8 in bar (docs/model.md §2)
     assert p.inertia_a == pytest.approx(5.08 * 0.3175 ** 3 / 12, rel=1e-3)
     assert p.area_a == pytest.approx(1.6129, rel=1e-4)
 

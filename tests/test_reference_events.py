@@ -7,7 +7,7 @@ sliding single and double contacts, a stick-slip cycle of contact {4},
 separations.
 
 The stick-slip cycle is driven by the beams' axial modes (1-2 kHz, damped
-at zeta < 1 %, MODEL.md §5): event by event it needs a step that resolves
+at zeta < 1 %, docs/model.md §5): event by event it needs a step that resolves
 them.  The kernel runs at KERNEL_DT (|lambda| dt = 0.26 for the fastest
 mode); at the default 1e-4 s (|lambda| dt = 2.05, where RK4 damps that
 mode by 0.71 per step) it takes 17 of the reference's 34 events.

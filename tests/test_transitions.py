@@ -1,9 +1,9 @@
 """Transitions in the model (workbench/core/transitions.py), the slot stop and the axial damping.
 
-MODEL.md §5-§7: the end stop's force is minus the gradient of its potential;
+docs/model.md §5-§7: the end stop's force is minus the gradient of its potential;
 the axial coordinates are damped at their own mode's zeta; Moreau-Jean steps
 never add kinetic energy and leave no closed point approaching; the
-accumulations, inconsistent regimes and floods of contact-diagnosis.md
+accumulations, inconsistent regimes and event floods of the runs that once failed
 end in finished runs with every impact dissipative.
 """
 import numpy as np
@@ -72,8 +72,8 @@ def test_moreau_jean_step_is_plastic_and_dissipative():
     work.rg[:] = 0.0
     st = np.zeros(ly.N_ST)
     h = 1e-4
-    status = moreau_jean_step(0.0, h, *model, X.none(), work.rec, work.mat, work.vec, work.cg,
-                              work.cw, work.rg, work.stages, st)
+    status = moreau_jean_step(0.0, h, *model, X.none(), work.rec, work.mat, work.vec, work.stages,
+                              work.cg, work.cw, work.rg, st)
     assert status == ly.OK
     after = work.stages[ly.STAGE_CUR]
     # the impulse stopped the approach of corner 2 (plastic) and removed energy
@@ -94,7 +94,7 @@ def hard_run(force_n, freq_hz, duration, **changes):
 
 @pytest.mark.parametrize("force_n, freq_hz", [(100.0, 45.0), (200.0, 50.0), (200.0, 30.0)])
 def test_the_diagnosed_failures_finish(force_n, freq_hz):
-    """contact-diagnosis.md: accumulations 1 <-> 3, opening 'impacts', the cycling settle, the jam."""
+    """Runs that once failed: accumulations 1 <-> 3, opening impacts, a cycling regime choice, a jam."""
     run = hard_run(force_n, freq_hz, 3.0)
     assert run.ok, run.message
     s = run.summary()

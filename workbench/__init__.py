@@ -1,5 +1,5 @@
 """Loose-joint workbench: a 9-DOF Gibbs-Appell model of a cantilever beam
-with a loose bolted lap joint (MODEL.md), compiled with numba."""
+with a loose bolted lap joint (docs/model.md), compiled with numba."""
 from .model.params import CORK_MODELS, ParameterError, Parameters
 
 __version__ = "0.1.0"

@@ -32,7 +32,8 @@ from pathlib import Path
 from . import __version__
 from .model.params import CORK_MODELS, ParameterError, Parameters, describe
 from .study.paths import check_output_dir, check_output_file
-from .model.limits import (FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MAX_OUTPUT_HZ, MIN_DT)
+from .model.limits import (FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MAX_OUTPUT_HZ,
+                           MIN_DT)
 
 EXIT_OK = 0
 EXIT_RUN_FAILED = 1
@@ -122,7 +123,7 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
                         help="set one parameter (repeatable), e.g. --set gap_mm=0.762")
     parser.add_argument("--tip-mass", type=_on_off, metavar="on|off", help="attach the tip mass")
-    parser.add_argument("--cork", choices=sorted(CORK_MODELS), help="cork model (MODEL.md §6)")
+    parser.add_argument("--cork", choices=sorted(CORK_MODELS), help="cork model (docs/model.md §6)")
 
 
 def _parameters(args) -> Parameters:
@@ -356,7 +357,7 @@ def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") ->
 
 def _record_settings(args, meta: dict) -> dict:
     """A record's settings (matching.py): the file's, overridden by the command line."""
-    from .study.definition import ALL_EXCITATION_KEYS
+    from .model import drives
 
     settings = dict(meta)
     given = {"gap_mm": args.gap_mm, "tip_mass": args.tip_mass, "cork": args.cork}
@@ -374,12 +375,13 @@ def _record_settings(args, meta: dict) -> dict:
     elif args.impulse is not None:
         drive = {"drive": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
     if drive:                  # a drive given here replaces the file's (its amplitude may stay)
-        for key in set(ALL_EXCITATION_KEYS) - {"force_n", "ramp_s"} | {"drive"}:
+        for key in set(drives.all_keys()) - {"force_n", "ramp_s"} | {"drive"}:
             settings.pop(key, None)
         settings.update(drive)
     if args.force_n is not None:
         settings["force_n"] = args.force_n
-    if args.ramp_s is not None and settings.get("drive") in ("sine", "chirp"):
+    if args.ramp_s is not None and drives.DRIVES.get(settings.get("drive")) is not None \
+            and drives.DRIVES[settings["drive"]].ramped:
         settings["ramp_s"] = args.ramp_s
     return settings
 
@@ -427,6 +429,7 @@ def _check_window(path, record, skip_s: float) -> None:
 
 def _cmd_compare(args) -> int:
     from .experiments.compare import compare
+    from .model import drives
     from .experiments.matching import setup_from
 
     from .experiments.compare import SIGNALS
@@ -442,7 +445,7 @@ def _cmd_compare(args) -> int:
     run = setup.simulate()
     title = f"{Path(args.file).name} vs simulation ({setup.excitation['kind']})"
     result = compare(record, run, out, skip_s=args.skip_s, threshold=args.threshold,
-                     chirp=setup.excitation["kind"] == "chirp", title=title)
+                     chirp=drives.DRIVES[setup.excitation["kind"]].swept, title=title)
     print(json_text({"record": args.file, "simulation_status": run.status, "out": str(out),
                       "figures": [str(p) for p in result.figures if p.suffix == ".png"],
                       "rms_error_rel": dict(zip(result.signals.channel,
@@ -516,7 +519,7 @@ def build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.set_defaults(func=_cmd_modes)
 
-    run = sub.add_parser("run", help="simulate one run with contact (MODEL.md §7-9)")
+    run = sub.add_parser("run", help="simulate one run with contact (docs/model.md §7-9)")
     _add_model_options(run)
     _add_joint_options(run)
     _add_drive_options(run, ramp_help=f"soft-start ramp of sine/chirp (s); default "

@@ -1,4 +1,4 @@
-"""Constrained dynamics of the 17 regimes (MODEL.md §7), jit-compiled.
+"""Constrained dynamics of the 17 regimes (docs/model.md §7), jit-compiled.
 
 A regime is a contact set (``rg[RG_SET]``, 0..8) and a stick flag.  Its
 active rows are the normal rows W_n = dg/dq of the set's points and, when
@@ -40,7 +40,7 @@ from .dynamics import rhs, solve_factored
 
 
 @nb.njit(**JIT_INLINE)
-def _put_row(cw, r, cg, geometry_row, friction_row, friction):
+def _put_row(cg, cw, r, geometry_row, friction_row, friction):
     """Constraint row r: A = d(geometry_row)/dq, B = A + friction d(friction_row)/dq."""
     a = cw[ly.CW_A + r]
     b = cw[ly.CW_B + r]
@@ -60,25 +60,25 @@ def set_rows(set_index, stick, sign, P, cg, cw):
     Row order: the normal rows of the set's first and second point, then,
     when sticking, the tangential row of the set's first point.  Slipping,
     each point's force direction is W_n,k - mu_k sigma W_t,k with its own
-    tangential row (MODEL.md §7).
+    tangential row (docs/model.md §7).
     """
     m = 0
     friction = 0.0 if stick else -P[ly.P_MU_K] * sign
     for which in range(2):
         p = ly.SET_FIRST[set_index] if which == 0 else ly.SET_SECOND[set_index]
         if p >= 0:
-            _put_row(cw, m, cg, ly.CG_G + p, ly.CG_T + p, friction)
+            _put_row(cg, cw, m, ly.CG_G + p, ly.CG_T + p, friction)
             m += 1
     if stick:
         tangent = ly.CG_T + tangent_point(set_index)
-        _put_row(cw, m, cg, tangent, tangent, 0.0)
+        _put_row(cg, cw, m, tangent, tangent, 0.0)
         m += 1
     return m
 
 
 @nb.njit(**JIT_INLINE)
 def tangent_point(set_index):
-    """The point whose tangential row a sticking regime holds: the set's first (MODEL.md §7).
+    """The point whose tangential row a sticking regime holds: the set's first (docs/model.md §7).
 
     In a double contact both normal rows and this row span the three joint
     coordinates, so the joint is locked; how the contact force splits
@@ -268,7 +268,7 @@ def stick_margin(P, free, cg, rg):
     n2, t2), scaled to unit largest entry; sticking holds while some split
     alpha has lambda_n,k >= 0 and |lambda_t,k| <= mu_s lambda_n,k at both
     points.  The margin is the width of that interval of alpha (dyn), so
-    that it reaches 0 where the per-point slip of MODEL.md §7 takes over.
+    that it reaches 0 where the per-point slip of docs/model.md §7 takes over.
     When the four rows span less than three dimensions (a flat double
     contact with psi held: the points' rows coincide) the margin is
     mu_s sum lambda_n - |lambda_t|.

@@ -1,4 +1,4 @@
-"""Contact geometry of the loose joint (MODEL.md §7), jit-compiled.
+"""Contact geometry of the loose joint (docs/model.md §7), jit-compiled.
 
 In the joint frame the plates' inner faces lie at y = +-H, H = h4/2 + gap/2,
 and the lips at x_lip; D = x_lip - x_in.  Four contact points (seed Fig. 4):
@@ -109,7 +109,7 @@ def row_to_dof(cg, row, scale, out):
 
 @nb.njit(**JIT_INLINE)
 def regime_of(set_index, stick):
-    """Regime number 0..16 of a contact set (0..8) and stick flag (MODEL.md §7)."""
+    """Regime number 0..16 of a contact set (0..8) and stick flag (docs/model.md §7)."""
     if set_index == 0:
         return 0
     return 2 * set_index - 1 if stick else 2 * set_index

@@ -1,4 +1,4 @@
-"""Gibbs-Appell equations of motion in free flight (MODEL.md §5-6).
+"""Gibbs-Appell equations of motion in free flight (docs/model.md §5-6).
 
     M(q) q'' = Q(q, q', t) - h(q, q'),     M = sum m J^T J + I a a^T,
                                            h = sum m J^T kappa
@@ -25,7 +25,7 @@ from .kinematics import beam_b_point, compute_frames, rigid_point, tip_row
 
 @nb.njit(**JIT)
 def fill_stiffness_damping(P, kc):
-    """Linear stiffness kc[KC_K] and damping kc[KC_C] (9, 9), MODEL.md §5.
+    """Linear stiffness kc[KC_K] and damping kc[KC_C] (9, 9), docs/model.md §5.
 
     Per beam: bending EI/L^3 [[12, -6L], [-6L, 4L^2]] on (w, phi) and axial
     EA/L on u (exact for the Hermite shapes); damping C_b = beta K_b on the
@@ -57,7 +57,7 @@ def fill_stiffness_damping(P, kc):
 
 @nb.njit(**JIT_INLINE)
 def cork_spring(s, n, k):
-    """The cork's spring force k sign(s)|s|^n (dyn), MODEL.md §6; products for the
+    """The cork's spring force k sign(s)|s|^n (dyn), docs/model.md §6; products for the
     paper's n = 1, 2, 3 (a power costs ~20x)."""
     a = abs(s)
     if n == 1.0:
@@ -77,7 +77,7 @@ def slot_overtravel(s, P):
 
 @nb.njit(**JIT_INLINE)
 def cork_force(s, sd, P):
-    """Cork force on the slide s (dyn), MODEL.md §6.
+    """Cork force on the slide s (dyn), docs/model.md §6.
 
     k sign(s)|s|^n + c s', plus the slot's end stop k_stop (|s| - s_travel)
     sign(s) beyond |s| > s_travel.
@@ -88,7 +88,7 @@ def cork_force(s, sd, P):
 
 @nb.njit(**JIT_INLINE)
 def cork_energy(s, P):
-    """Cork potential k |s|^(n+1) / (n+1) + k_stop (|s| - s_travel)_+^2 / 2 (erg), MODEL.md §6."""
+    """Cork potential k |s|^(n+1) / (n+1) + k_stop (|s| - s_travel)_+^2 / 2 (erg), docs/model.md §6."""
     n = P[ly.P_CORK_N]
     over = slot_overtravel(s, P)
     return P[ly.P_CORK_K] * abs(s) ** (n + 1.0) / (n + 1.0) + 0.5 * P[ly.P_K_STOP] * over * over

@@ -1,4 +1,4 @@
-"""Shaker force F(t) at force1 (MODEL.md §8), jit-compiled.
+"""Shaker force F(t) at force1 (docs/model.md §8), jit-compiled.
 
     sine:   F = F0 sin(2 pi f t)
     chirp:  F = F0 sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T)))
@@ -6,14 +6,14 @@
 Both multiplied by a soft-start ramp 1/2 (1 - cos(pi t / t_ramp)) while
 t < t_ramp, so the lightly damped first mode is not kicked by a sudden start.
 
-Hammer pulses (MODEL.md §8, seed §4.3 and §5.4) are half-sines
+Hammer pulses (docs/model.md §8, seed §4.3 and §5.4) are half-sines
 F = F0 sin(pi (t - t_hit) / width) for t_hit <= t <= t_hit + width.
 """
 import math
 
 import numba as nb
 
-from .config import JIT, JIT_INLINE
+from .config import JIT_INLINE
 from . import layout as ly
 
 

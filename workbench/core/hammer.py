@@ -1,7 +1,7 @@
 """Kernels of the axial hammer test (seed §4.3, Table 6).
 
 The loose body, beam B and the tip mass slide as one mass m against the
-cork (MODEL.md §6): m s'' = -k sign(s) |s|^n - c s', released at s = 0 with
+cork (docs/model.md §6): m s'' = -k sign(s) |s|^n - c s', released at s = 0 with
 the hammer's velocity v0.  The accelerometer on the tip reads s''.
 Integrated by RK4 with ``substeps`` steps per record sample.
 """

@@ -1,4 +1,4 @@
-"""Event-driven integration of the 17-regime model (MODEL.md §7), jit-compiled.
+"""Event-driven integration of the 17-regime model (docs/model.md §7), jit-compiled.
 
 Fixed RK4 steps in the current regime; after each step the events of the
 regime are evaluated (every event function goes from + to - when its event
@@ -39,26 +39,17 @@ samples and the log written so far.
 """
 import numba as nb
 
-from .config import EVENT_TIME_TOL, JIT, JIT_INLINE, LAMBDA_EPS, MAX_EVENTS_PER_STEP, RATE_EPS
+from .config import (ACCUM_GAP_TOL, ACCUM_STEPS, CLOSED_RATE, EVENT_TIME_TOL, GAP_TOL,
+                     GRAZE_ITERS, GRAZE_MARGIN, JIT, JIT_INLINE, LAMBDA_EPS,
+                     MAX_EVENTS_PER_STEP, RATE_EPS, STEPPED_STEPS)
 from . import layout as ly
 from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
 from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
 from .dynamics import rhs
 from .integrate import rk4_step
 from .sensors import fill_signals
-from .transitions import (ACCUM_GAP_TOL, CLOSED_RATE, GAP_TOL, choose_regime, impact, moreau_jean_step)
+from .transitions import choose_regime, impact, moreau_jean_step
 
-#: Impacts recurring within this many steps, or closing slower than the gap's
-#: free acceleration makes in this many steps, are an accumulation (MODEL.md §7).
-ACCUM_STEPS = 3.0
-#: Steps of Moreau-Jean time-stepping after an event flood before the
-#: event-driven steps resume.
-STEPPED_STEPS = 10
-#: A gap that turns within a step is evaluated where its Hermite interpolant
-#: comes within this fraction of its change of slope (m1 - m0) of zero ...
-GRAZE_MARGIN = 0.02
-#: ... and its minimum followed for at most this many trial states.
-GRAZE_ITERS = 4
 
 
 @nb.njit(**JIT)
@@ -105,12 +96,12 @@ def _copy_ev(ev, src, dst):
 
 
 @nb.njit(**JIT)
-def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
+def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY."""
     y = stages[ly.STAGE_CUR]
     y_try = stages[ly.STAGE_TRY]
-    status = rk4_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                      stages, y_try)
+    status = rk4_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                      rg, y_try)
     if status == ly.OK:
         status = rhs_regime(t + theta * h, y_try, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
                             rg, stages[ly.STAGE_KTRY])
@@ -155,8 +146,8 @@ def _hermite_min(f0, f1, m0, m1):
 
 
 @nb.njit(**JIT)
-def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
-           stages):
+def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+           ev):
     """Does gap event e dip below zero inside the step though it is positive at both ends?
 
     The gap turns within the step (slopes m0 < 0 < m1 per unit theta).  The
@@ -177,7 +168,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
     for _ in range(GRAZE_ITERS):
         if not (0.0 < x < before):
             return ly.OK, -1.0
-        status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages)
+        status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, -1.0
         f = ev[ly.EV_TRY, e]
@@ -199,7 +190,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
 
 
 @nb.njit(**JIT)
-def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
+def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """Locate event e's sign change in (0, hi) by the Illinois method, to EVENT_TIME_TOL.
 
     ``flo`` >= 0 is its value at the step's start, ``fhi`` < 0 at ``hi``,
@@ -217,7 +208,7 @@ def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
             x = hi - fhi * (hi - lo) / (fhi - flo)
             if not (lo < x < hi):
                 x = 0.5 * (lo + hi)
-        status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages)
+        status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, hi
         f = ev[ly.EV_TRY, e]
@@ -239,7 +230,7 @@ def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
 
 
 @nb.njit(**JIT)
-def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
+def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """The earliest event in the step (t, t + h) from STAGE_CUR to STAGE_NEXT.
 
     Returns ``(status, event, theta)``: event -1 if none; else the state
@@ -264,7 +255,7 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
             m1 = h * ev[ly.EV_RATE_END, e]
             if m0 < 0.0 and m1 > 0.0:
                 status, x = _graze(e, t, h, f0, f1, m0, m1, best_theta, P, tab, kc, free, ex,
-                                   rec, mat, vec, cg, cw, rg, ev, stages)
+                                   rec, mat, vec, stages, cg, cw, rg, ev)
                 if status != ly.OK:
                     return status, -1, 0.0
                 if x >= 0.0:
@@ -281,8 +272,8 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
         elif hi == 1.0:
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
-        status, hi = _bracket(e, f0, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
-                              rg, ev, stages)
+        status, hi = _bracket(e, f0, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+                              cw, rg, ev)
         if status != ly.OK:
             return status, -1, 0.0
         best = e
@@ -302,7 +293,7 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages):
             break
         status, hi = _bracket(earlier, ev[ly.EV_START, earlier], best_theta,
                               ev[ly.EV_HI, earlier], t, h, P, tab, kc, free, ex, rec, mat, vec,
-                              cg, cw, rg, ev, stages)
+                              stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, -1, 0.0
         best = earlier
@@ -335,7 +326,7 @@ def _log(log, n_log, t, kind, reg_from, reg_to, point):
 
 @nb.njit(**JIT)
 def _accumulating(t, y, point, P, cg, st, dt, k1):
-    """Whether an impact of ``point`` at t belongs to an accumulation (MODEL.md §7).
+    """Whether an impact of ``point`` at t belongs to an accumulation (docs/model.md §7).
 
     Impacts recurring within ACCUM_STEPS steps, or a closing rate below
     what the free gap acceleration makes in ACCUM_STEPS steps.
@@ -351,7 +342,7 @@ def _accumulating(t, y, point, P, cg, st, dt, k1):
 
 
 @nb.njit(**JIT)
-def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, log,
+def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, log,
                 n_log, st):
     """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
 
@@ -415,7 +406,7 @@ def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, s
         rg[ly.RG_STICK] = 1.0
         kind = ly.KIND_SLIP_STICK
         point = ly.SET_FIRST[set_index] + 1
-    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, k1, st,
+    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, k1, st,
                            gap_tol)
     if status != ly.OK:
         return status
@@ -440,20 +431,20 @@ def _immediate_impact(ev):
 
 
 @nb.njit(**JIT)
-def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev, stages, st):
+def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st):
     """A Moreau-Jean step of h from (t, STAGE_CUR), then the regime chosen at t + h."""
-    status = moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st)
+    status = moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st)
     if status != ly.OK:
         return status
-    status = choose_regime(t + h, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec, cg,
-                           cw, rg, stages, stages[ly.STAGE_K1], st, GAP_TOL)
+    status = choose_regime(t + h, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec, stages,
+                           cg, cw, rg, stages[ly.STAGE_K1], st, GAP_TOL)
     if status == ly.OK:
         event_values(stages[ly.STAGE_CUR], P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
     return status
 
 
 @nb.njit(**JIT)
-def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
+def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
            out_t, out_y, out_sig):
     y = stages[ly.STAGE_CUR]
     k = stages[ly.STAGE_KTRY]
@@ -500,7 +491,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
         st[ly.ST_T_IMPACT] = -1e300
         st[ly.ST_S_MIN] = y[ly.S]
         st[ly.ST_S_MAX] = y[ly.S]
-    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages,
+    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
                            stages[ly.STAGE_K1], st, GAP_TOL)
     if status != ly.OK:
         return status, stored, n_log
@@ -510,7 +501,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
              regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
         n_log += 1
     if step0 == 0:
-        status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
+        status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
                         out_t, out_y, out_sig)
         if status != ly.OK:
             return status, stored, n_log
@@ -522,8 +513,8 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
         t_end = t0 + step * dt
         n_step_events = 0
         if stepped_left > 0:
-            status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ev,
-                              stages, st)
+            status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+                              ev, st)
             if status != ly.OK:
                 st[ly.ST_T] = t
                 return status, stored, n_log
@@ -535,8 +526,8 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                 break
             e = _immediate_impact(ev)
             if e < 0:
-                status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                                  stages, stages[ly.STAGE_NEXT])
+                status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                  rg, stages[ly.STAGE_NEXT])
                 if status == ly.OK:
                     correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
                     st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
@@ -546,8 +537,8 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                 if status != ly.OK:
                     return status, stored, n_log
                 event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-                status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                                          ev, stages)
+                status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                          rg, ev)
                 if status != ly.OK:
                     return status, stored, n_log
                 if e < 0:
@@ -571,16 +562,16 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
                     # time-stepping through the rest of this step and STEPPED_STEPS more
                     status = ly.OK
                     if t_end - t > 1e-15 * dt:
-                        status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, cg,
-                                          cw, rg, ev, stages, st)
+                        status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages,
+                                          cg, cw, rg, ev, st)
                     if status != ly.OK:
                         st[ly.ST_T] = t
                         return status, stored, n_log
                     t = t_end
                     stepped_left = STEPPED_STEPS
                     break
-                status = apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                                     ev, stages, log, n_log, st)
+                status = apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                     rg, ev, log, n_log, st)
                 if status != ly.OK:
                     st[ly.ST_T] = t
                     return status, stored, n_log
@@ -594,7 +585,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
         st[ly.ST_T] = t
         st[ly.ST_STEP] = step0 + step
         if (step0 + step) % decim == 0:
-            status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st,
+            status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
                             out_t, out_y, out_sig)
             if status != ly.OK:
                 return status, stored, n_log

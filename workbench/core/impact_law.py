@@ -1,4 +1,4 @@
-"""Moreau's impact law with Coulomb friction for at most two points (MODEL.md §7).
+"""Moreau's impact law with Coulomb friction for at most two points (docs/model.md §7).
 
 The law alone, without the model's geometry: the points' normal and
 tangential rows enter only through the Delassus matrix G = W M^-1 W^T and
@@ -28,16 +28,12 @@ beta-, and the slip speed) is solved by Lemke's complementary pivoting.
 import numba as nb
 import numpy as np
 
-from .config import JIT, JIT_INLINE
+from .config import JIT, JIT_INLINE, LAW_RANK_TOL, LAW_REL_TOL
 from . import layout as ly
 
 OPEN, STICK, SLIP_POS, SLIP_NEG = 0, 1, 2, 3
 #: Solution sources returned by :func:`solve_impact`.
 FOUND_ENUMERATION, FOUND_LEMKE, NOT_FOUND = 1, 2, 0
-#: Relative tolerance of the conditions (on the rates' and impulses' scales).
-LAW_REL_TOL = 1e-9
-#: A pivot below this fraction of the largest entry is a dependent row.
-LAW_RANK_TOL = 1e-10
 
 
 @nb.njit(**JIT_INLINE)

@@ -1,4 +1,4 @@
-"""Mass matrix, convective and gravity terms summed frame by frame (MODEL.md §5).
+"""Mass matrix, convective and gravity terms summed frame by frame (docs/model.md §5).
 
 The per-element sums of :mod:`workbench.core.dynamics`
 

@@ -13,7 +13,7 @@ import math
 
 import numba as nb
 
-from .config import JIT, JIT_INLINE
+from .config import JIT
 from . import layout as ly
 from .constrained import rhs_regime
 
@@ -25,7 +25,7 @@ _B = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
 
 
 @nb.njit(**JIT)
-def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, y_new):
+def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, y_new):
     """One RK4 step from (t, y) into y_new (may not alias y) in the regime of rg.
 
     k1 = f(t, y) must already be in stages[STAGE_K1] (the caller evaluated
@@ -59,7 +59,7 @@ def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, 
     """Integrate n_steps RK4 steps of size dt (s) from (t0, y0) in free flight.
 
     No contact: the loose body passes through the plates, so use it with the
-    joint locked or held by springs (MODEL.md §7 contact is in
+    joint locked or held by springs (docs/model.md §7 contact is in
     :mod:`workbench.core.hybrid`).  y0 is (q, q') (18,).  Stores the initial
     state and every ``decim``-th state into ``out_t`` (n_out,) and ``out_y``
     (n_out, 18), n_out >= n_steps // decim + 1.  Returns ``(status,
@@ -84,8 +84,8 @@ def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, 
         status = rhs_regime(t, y_cur, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                             stages[ly.STAGE_K1])
         if status == ly.OK:
-            status = rk4_step(t, y_cur, dt, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                              stages, y_next)
+            status = rk4_step(t, y_cur, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                              rg, y_next)
         if status != ly.OK:
             return status, stored
         for i in range(ly.N_AUG):

@@ -1,6 +1,6 @@
 """Positions, Jacobians and convective accelerations of every mass element.
 
-MODEL.md §4-5.  The chain is: beam A (root frame = global frame), the joint
+docs/model.md §4-5.  The chain is: beam A (root frame = global frame), the joint
 frame at beam A's tip (angle alpha3 = phi_A), the loose-body frame at
 d = (x_in + s, v) in the joint frame (angle alpha4 = phi_A + psi), and beam B
 and the tip mass in the loose-body frame, offset by l4.
@@ -13,7 +13,7 @@ give its acceleration r'' = J q'' + kappa:
     kappa  = kappa0 + R (rho''_conv + 2 alpha' S rho' - alpha'^2 rho)
 
 with R S = S R the derivative of the rotation, and for a beam point the
-convective part of the foreshortening -b'^T Sigma b' (MODEL.md §5).
+convective part of the foreshortening -b'^T Sigma b' (docs/model.md §5).
 
 All functions are jit-compiled and write point records (layout ``RX`` ...
 ``RATE`` of :mod:`~workbench.core.layout`) into rows of ``rec``.  They are
@@ -31,7 +31,7 @@ from . import layout as ly
 
 @nb.njit(**JIT_INLINE)
 def beam_point_local(row, q, qd, i0, x_offset, rec, dst):
-    """A beam point in the beam's root frame (MODEL.md §4) into ``rec[dst]``.
+    """A beam point in the beam's root frame (docs/model.md §4) into ``rec[dst]``.
 
     ``row`` a shape-table row, ``i0`` the beam's first coordinate (W_A or
     W_B), ``x_offset`` the root's position along the frame's x axis (cm).

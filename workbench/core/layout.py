@@ -3,7 +3,7 @@
 The kernels see the model as a few flat arrays.  This module is the one place
 that names their entries; nothing else hard-codes an index.
 
-Generalised coordinates (MODEL.md §3, seed §2.1: three per beam, three in the
+Generalised coordinates (docs/model.md §3, seed §2.1: three per beam, three in the
 joint)::
 
     q = (w_A, phi_A, u_A,  s, v, psi,  w_B, phi_B, u_B)
@@ -68,7 +68,7 @@ N_PARAMS = 42
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):
-# the Hermite shape functions of MODEL.md §4 and the foreshortening matrix
+# the Hermite shape functions of docs/model.md §4 and the foreshortening matrix
 # Sigma(x) at that point, and the point's quadrature length weight.
 T_XI = 0      # x / L (-)
 T_X = 1       # x (cm)
@@ -99,7 +99,7 @@ N_EXC = 9
 EXC_NONE = 0
 EXC_SINE = 1          # shaker at force1
 EXC_CHIRP = 2         # shaker at force1
-EXC_HAMMER_JOINT = 3  # vertical half-sine pulse at the joint body's base (MODEL.md §8)
+EXC_HAMMER_JOINT = 3  # vertical half-sine pulse at the joint body's base (docs/model.md §8)
 EXC_HAMMER_TIP = 4    # half-sine pulse along beam B's axis at its tip (§4.3)
 
 # --- status codes ------------------------------------------------------------
@@ -185,7 +185,7 @@ A_FRIC = N_STATE + 3    # dissipated by Coulomb friction while slipping
 A_CONSTR = N_STATE + 4  # work of the normal and sticking contact forces (ideally 0)
 N_AUG = N_STATE + 5
 
-# --- contact (MODEL.md §7) ---------------------------------------------------
+# --- contact (docs/model.md §7) ---------------------------------------------------
 N_POINTS = 4
 # Geometry record cg (2 N_POINTS, N_CG): rows G1..G4 are the gaps g_k, rows
 # T1..T4 the tangential coordinates tau_k; columns the value, gradient with
@@ -197,7 +197,7 @@ CG_DS, CG_DV, CG_DPSI = 1, 2, 3
 CG_HSS, CG_HSV, CG_HSP, CG_HVV, CG_HVP, CG_HPP = 4, 5, 6, 7, 8, 9
 N_CG = 10
 
-# Contact sets (points 0-based), in the order of MODEL.md §7: set k of regimes
+# Contact sets (points 0-based), in the order of docs/model.md §7: set k of regimes
 # 2k - 1 (stick) and 2k (slip).  -1 marks no point.
 N_SETS = 9
 SET_FIRST = (-1, 0, 1, 2, 3, 0, 0, 1, 1)
@@ -273,7 +273,7 @@ ST_N_IMPACTS = 3
 ST_E_IMPACT = 4      # kinetic energy lost in impacts (erg)
 ST_T = 5             # time reached (s)
 ST_STEP = 6          # steps completed
-ST_N_ACCUM = 7       # accumulations of impacts closed by a full-set impact (MODEL.md §7)
+ST_N_ACCUM = 7       # accumulations of impacts closed by a full-set impact (docs/model.md §7)
 ST_E_ACCUM = 8       # kinetic energy those impacts removed (erg; also in ST_E_IMPACT)
 ST_N_INCONSISTENT = 9    # states with no consistent regime resolved by the impact law
 ST_E_INCONSISTENT = 10   # kinetic energy those impulses removed (erg; also in ST_E_IMPACT)

@@ -1,4 +1,4 @@
-"""The sensor channels and energy record of one output sample (MODEL.md §9).
+"""The sensor channels and energy record of one output sample (docs/model.md §9).
 
 Called right after :func:`~workbench.core.constrained.rhs_regime` at the
 sample's state, whose frames, mass matrix, contact forces and q'' it reads.

@@ -1,4 +1,4 @@
-"""Cubic Hermite beam shapes and the foreshortening matrix (MODEL.md §4).
+"""Cubic Hermite beam shapes and the foreshortening matrix (docs/model.md §4).
 
 A clamped beam of length L with tip deflection w, tip slope phi and tip
 elongation u has, with xi = x / L::

@@ -1,4 +1,4 @@
-"""Transitions of the 17-regime model (MODEL.md §7), jit-compiled.
+"""Transitions of the 17-regime model (docs/model.md §7), jit-compiled.
 
 :func:`impact` is the momentum transfer: Moreau's impact law with e = 0
 (:mod:`workbench.core.impact_law`) over the impact set, the point that
@@ -27,27 +27,15 @@ import math
 
 import numba as nb
 
-from .config import GAP_EPS, JIT, JIT_INLINE, LAMBDA_EPS
+from .config import (CLOSED_RATE, GAP_EPS, GAP_TOL, JIT, JIT_INLINE, LAMBDA_EPS, REGIME_REL_TOL,
+                     REST_RATE)
 from . import layout as ly
-from .constrained import (add_contact_forces, fill_delassus, kinetic_energy, project, rhs_regime, stick_margin, stick_tolerance, tangent_point, _put_row)
+from .constrained import (add_contact_forces, fill_delassus, kinetic_energy, project, rhs_regime,
+                          stick_margin, stick_tolerance, tangent_point, _put_row)
 from .contact import fill_geometry, in_set, row_convective, row_rate, set_of
 from .dynamics import rhs
 from .impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, solve_impact
 
-#: A point whose gap is within this of zero (cm) is closed or closing: it joins
-#: an impact and may stay closed in the regime choice.  RK4's gaps carry errors
-#: of ~1e-8-1e-7 cm at the default step (contact-diagnosis.md §3).
-GAP_TOL = 1e-7
-#: Within an accumulation of impacts (MODEL.md §7) the impact set takes
-#: points this close (cm): a corner lifted by the previous micro-impact.
-ACCUM_GAP_TOL = 1e-5
-#: A closed point's normal rate is below this (cm/s).
-CLOSED_RATE = 1e-6
-#: A slip velocity below this (cm/s) is at rest: stick, or slip either way.
-REST_RATE = 1e-6
-#: Relative tolerance of the regime conditions (on the forces' and the
-#: accelerations' scales).
-REGIME_REL_TOL = 1e-9
 
 
 @nb.njit(**JIT_INLINE)
@@ -108,7 +96,7 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
     in rg (read from the solution, not yet chosen at acceleration level);
     leaves P in cw[CW_P] for the points in cw[CW_PTS].
 
-    ``close_within`` > 0 (s) closes an accumulation (MODEL.md §7): a point
+    ``close_within`` > 0 (s) closes an accumulation (docs/model.md §7): a point
     of the set that leaves the impact slower than its free gap acceleration
     (from the free accelerations a0, 9 values) brings it back within that
     time is held closed: one more normal impulse brings the normal rates
@@ -125,8 +113,8 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
     mu = cw[ly.CW_MU]
     for i in range(m):
         p = int(pts[i])
-        _put_row(cw, 2 * i, cg, ly.CG_G + p, ly.CG_G + p, 0.0)
-        _put_row(cw, 2 * i + 1, cg, ly.CG_T + p, ly.CG_T + p, 0.0)
+        _put_row(cg, cw, 2 * i, ly.CG_G + p, ly.CG_G + p, 0.0)
+        _put_row(cg, cw, 2 * i + 1, ly.CG_T + p, ly.CG_T + p, 0.0)
         u[2 * i] = row_rate(cg, ly.CG_G + p, qd)
         u[2 * i + 1] = row_rate(cg, ly.CG_T + p, qd)
         mu[i] = P[ly.P_MU_K]
@@ -356,9 +344,9 @@ def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
 
 
 @nb.njit(**JIT)
-def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, ydot, st,
+def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ydot, st,
                   gap_tol):
-    """Choose the consistent regime at y (MODEL.md §7 "Choosing the regime").
+    """Choose the consistent regime at y (docs/model.md §7 "Choosing the regime").
 
     The regime in rg is the proposal.  Projects y onto the chosen regime
     and leaves its right-hand side in ydot and its forces in rg.  A state
@@ -417,8 +405,8 @@ def arm_gaps(y, P, cg, rg):
 
 
 @nb.njit(**JIT)
-def moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, stages, st):
-    """One Moreau-Jean step (theta = 1/2) of h (s) from STAGE_CUR, in place (MODEL.md §7).
+def moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st):
+    """One Moreau-Jean step (theta = 1/2) of h (s) from STAGE_CUR, in place (docs/model.md §7).
 
     Acary & Brogliato (2008), §10.1: q_m = q + h/2 q'; the free velocity
     v_f = q' + h M(q_m)^-1 (Q - h)(t + h/2, q_m, q'); the impact law over

@@ -2,10 +2,9 @@
 
 A record's settings come from its file (``WB_`` keys, :mod:`workbench.experiments.files`)
 and from the command line, which wins.  The keys are those of a study
-(:mod:`workbench.study.definition`): ``drive`` (the excitation kind: sine, chirp,
-free_decay, hammer_joint, hammer_tip, none) with its settings (``freq_hz``,
-``force_n``, ``ramp_s``, ``f0_hz``, ``f1_hz``, ``sweep_s``,
-``deflection_cm``, ``width_s``, ``t_hit_s``), and any model parameter of
+(:mod:`workbench.study.definition`): ``drive`` (a kind of
+:mod:`workbench.model.drives`: sine, chirp, free_decay, hammer_joint,
+hammer_tip, none) with its settings (``freq_hz``, ``force_n``, ...), and any model parameter of
 ``workbench params`` (``gap_mm``, ``tip_mass``, ``cork``, ``e_b_gpa``, ...).
 The duration and sample rate are the record's.
 """
@@ -17,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from ..model.params import ParameterError, Parameters, resolve_name
-from ..study.definition import EXCITATION_DEFAULTS, EXCITATION_KEYS, excitation_array
+from ..model import drives
 
 
 @dataclass(frozen=True)
@@ -34,9 +33,8 @@ class Setup:
         from ..model.simulate import simulate
 
         exc = excitation or self.excitation
-        free = exc.get("deflection_cm") if exc["kind"] == "free_decay" else None
-        return simulate(params or self.params, excitation_array(exc), self.duration,
-                        output_hz=self.output_hz, free_decay_cm=free)
+        return simulate(params or self.params, drives.excitation_array(exc), self.duration,
+                        output_hz=self.output_hz, **drives.start_keywords(exc))
 
     def meta(self, model_keys: dict) -> dict:
         """The ``WB_`` settings to write with a simulated record of this setup."""
@@ -48,10 +46,9 @@ def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = N
     """The Setup of ``record`` from its settings (module docstring)."""
     settings = dict(settings)
     kind = settings.pop("drive", "none")
-    if kind not in EXCITATION_KEYS:
-        raise ParameterError(f"drive = {kind!r}: use one of {', '.join(EXCITATION_KEYS)}")
+    drive = drives.get(kind, where="drive")
     exc = {"kind": kind}
-    for key in EXCITATION_KEYS[kind]:
+    for key in drive.keys:
         if key in settings:
             value = settings.pop(key)
             try:
@@ -59,12 +56,12 @@ def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = N
             except (TypeError, ValueError, OverflowError):
                 raise ParameterError(f"{key} = {value!r} is not a number (WB_{key} in the file, "
                                      "or its option)") from None
-        elif key in EXCITATION_DEFAULTS:
-            exc[key] = EXCITATION_DEFAULTS[key]
+        elif key in drives.DEFAULTS:
+            exc[key] = drives.DEFAULTS[key]
         else:
             raise ParameterError(f"a {kind} drive needs {key} (in the file as WB_{key}, or "
                                  "on the command line)")
-    for key in [k for k in settings if k in set().union(*EXCITATION_KEYS.values())]:
+    for key in [k for k in settings if k in drives.all_keys()]:
         raise ParameterError(f"{key} does not apply to a {kind} drive")
     for key in settings:
         resolve_name(key)                 # names the parameter if it is unknown
@@ -75,5 +72,5 @@ def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = N
     if abs(output_hz - rate) > 1e-6 * rate:
         raise ParameterError(f"the record's sample rate {rate} Hz is not a whole number of Hz")
     duration = round(float(t[-1] - t[0]) * output_hz) / output_hz
-    excitation_array(exc)                 # validates the values
+    drives.excitation_array(exc)          # validates the values
     return Setup(params, exc, duration, output_hz)

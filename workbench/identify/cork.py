@@ -1,4 +1,4 @@
-"""Cork stiffness and damping (seed §4.3, Tables 5-6; MODEL.md §6).
+"""Cork stiffness and damping (seed §4.3, Tables 5-6; docs/model.md §6).
 
 Two methods, as in the paper:
 

@@ -28,7 +28,7 @@ TABLE4 = {"inertia_3": "24904", "inertia_4": "1398.60", "inertia_6": "301.55",
 TABLE5 = [(3.14e6, 0.71, 0.635, "4.19e7"),
           (4.12e6, 0.77, 0.585, "2.23e7"),
           (3.92e6, 0.635, 0.58, "7.13e7")]
-#: MODEL.md §6's static cork: the mean of Table 5 (g/s^2).
+#: docs/model.md §6's static cork: the mean of Table 5 (g/s^2).
 TABLE5_MEAN = "4.52e7"
 
 #: Table 6: test, law, stiffness (g/(s^2 cm^(n-1))), damping (g/s).
@@ -53,7 +53,7 @@ APPENDIX_B = [
 #: §4.4: "The computed average moduli of elasticity for the first and second
 #: are 50.48 GPa and 46.12 GPa".
 APPENDIX_B_MEAN_E_GPA = {1: "50.48", 2: "46.12"}
-#: The beams' lengths are not printed; MODEL.md §2 infers them from
+#: The beams' lengths are not printed; docs/model.md §2 infers them from
 #: Appendix B (ASSUMPTION): cm, by beam.
 BEAM_LENGTH_CM = {1: 36.671, 2: 33.099}
 

@@ -85,7 +85,7 @@ def table5() -> pd.DataFrame:
         ks.append(k)
         rows.append(_row(f"trial {i}: {load:.3g} dyn, {pre} -> {loaded} cm (g/s^2)", printed, k,
                          "Hooke: F / (gap before - gap under load)"))
-    rows.append(_row("mean (g/s^2), MODEL.md's static cork", P.TABLE5_MEAN,
+    rows.append(_row("mean (g/s^2), docs/model.md's static cork", P.TABLE5_MEAN,
                      statistics.mean(float(row[3]) for row in P.TABLE5),
                      "mean of the printed (rounded) stiffnesses; "
                      f"of the exact quotients {statistics.mean(ks):.3g}"))
@@ -129,7 +129,7 @@ _HOW_B = {
     "Td (s)": "(tn - t1) / n, to 1e-6 s",
     "zeta": "delta = ln(x1/xn) / (n - 1); zeta = delta / sqrt(4 pi^2 + delta^2)",
     "omega_n (rad/s)": "2 pi / (Td sqrt(1 - zeta^2)) from the tabulated Td",
-    "EI (g cm^3/s^2)": "11 mu omega_n^2 L^4 / 140 (Eq. 2), L of MODEL.md (ASSUMPTION)",
+    "EI (g cm^3/s^2)": "11 mu omega_n^2 L^4 / 140 (Eq. 2), L of docs/model.md (ASSUMPTION)",
     "E (GPa)": "EI / I, I = rho I / rho of Tables 3-4",
 }
 
@@ -144,11 +144,11 @@ Conventions needed to reproduce Appendix B to the printed digits: the damped
 period is (tn - t1)/n but the decrement is ln(x1/xn)/(n - 1), and omega_n
 is computed from Td as tabulated (rounded to 1e-6 s); with the exact Td the
 last digit of omega_n differs in four of six rows.  The beams' lengths are
-not printed: MODEL.md infers L_A = 36.671 cm and L_B = 33.099 cm from these
+not printed: docs/model.md infers L_A = 36.671 cm and L_B = 33.099 cm from these
 same rows, so the EI column checks that the three trials of a beam agree
 with one length, not the length itself.  E uses I = (rho I)/rho of
 Tables 4 and 3 (0.013549 cm^4); with b h^3/12 of the bar (0.0135492 cm^4)
-beam 1 trial 2 gives 50.50 GPa instead of the printed 50.51.  MODEL.md's
+beam 1 trial 2 gives 50.50 GPa instead of the printed 50.51.  docs/model.md's
 static cork stiffness 4.52e7 g/s^2 is the mean of Table 5's printed,
 rounded values.  Table 6's hammer records are not published: its rows
 are fitted to records simulated with the printed values (see the "how"

@@ -1,4 +1,4 @@
-"""Excitations at the user boundary (MODEL.md §8), converted once to CGS.
+"""Excitations at the user boundary (docs/model.md §8), converted once to CGS.
 
 Forces are given in newtons (1 N = 1e5 dyn) and frequencies in Hz; the
 result is the kernel's excitation array (layout ``X_*``).

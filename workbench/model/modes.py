@@ -88,7 +88,7 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
 
     They set the explicit integrator's step (:func:`workbench.model.simulate.default_dt`):
     the fastest are the beams' axial modes, damped at their own zeta
-    (MODEL.md §5): -246 +- 2.05e4 j 1/s with the tip mass, -321 +- 3.54e4 j
+    (docs/model.md §5): -246 +- 2.05e4 j 1/s with the tip mass, -321 +- 3.54e4 j
     without.
     """
     out = []

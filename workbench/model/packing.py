@@ -12,7 +12,7 @@ Holding coordinates fixed
 ``build(params, fixed=("s", "v", "psi"))`` holds the named coordinates at
 their initial values: their equations are dropped and their accelerations
 are zero.  Their initial velocities must be zero.  ``JOINT`` names the three
-joint coordinates, so ``fixed=JOINT`` is the locked joint of MODEL.md.
+joint coordinates, so ``fixed=JOINT`` is the locked joint of docs/model.md.
 """
 from __future__ import annotations
 

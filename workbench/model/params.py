@@ -1,10 +1,10 @@
-"""Every physical parameter of the model, with its source (MODEL.md §2, §6).
+"""Every physical parameter of the model, with its source (docs/model.md §2, §6).
 
 Units are CGS inside (g, cm, s; force in dyn, E in g/(cm s^2)).  At the user
 boundary a parameter may also be given with a unit suffix, converted once
 here: ``gap_mm=0.762``, ``l4_mm=116.7``, ``e_a_gpa=50.48``.
 
-Numbers marked ASSUMPTION are inferences of MODEL.md (the paper's drawing was
+Numbers marked ASSUMPTION are inferences of docs/model.md (the paper's drawing was
 lost); they are ordinary, overridable parameters, flagged in
 :data:`FIELDS` and in ``workbench params``.
 
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-#: Cork models of MODEL.md §6 (seed §4.3, Tables 5-6): (n, k, c), with k in
+#: Cork models of docs/model.md §6 (seed §4.3, Tables 5-6): (n, k, c), with k in
 #: g/(s^2 cm^(n-1)) and c in g/s.  c = 1.7e4 g/s is the paper's average.
 CORK_MODELS: dict[str, tuple[float, float, float]] = {
     "none": (1.0, 0.0, 0.0),
@@ -112,7 +112,7 @@ class Parameters:
                      assumption=True, doc="static friction coefficient")
     mu_k: float = _p(0.3, "-", "the paper gives none", 0.0, 5.0, lo_open=False,
                      assumption=True, doc="kinetic friction coefficient (<= mu_s)")
-    # --- cork (MODEL.md §6) -------------------------------------------------
+    # --- cork (docs/model.md §6) -------------------------------------------------
     cork: str = _p("cubic", "-", "§4.3: the cubic model gave the best agreement",
                    doc="cork model: " + ", ".join(CORK_MODELS))
     cork_n: float | None = _p(None, "-", "from the cork model", 1.0, 5.0, lo_open=False,
@@ -193,12 +193,12 @@ class Parameters:
         return 3.516 / L ** 2 * math.sqrt(e * inertia / mu)
 
     def damping_beta(self, beam: str) -> float:
-        """Bending damping C_b = beta K_b: beta = 2 zeta / omega_1 (s), MODEL.md §5."""
+        """Bending damping C_b = beta K_b: beta = 2 zeta / omega_1 (s), docs/model.md §5."""
         zeta = self.zeta_a if beam == "a" else self.zeta_b
         return 2.0 * zeta / self.first_frequency(beam)
 
     def axial_mass(self, beam: str) -> float:
-        """Mass (g) on a beam's tip elongation u at rest: M(0)[u, u] of MODEL.md §5.
+        """Mass (g) on a beam's tip elongation u at rest: M(0)[u, u] of docs/model.md §5.
 
         The beam's own mu L / 3 (u(x) = xi u_tip) plus every body carried
         outboard along the axis: for beam A the joint body, the loose body,
@@ -210,7 +210,7 @@ class Parameters:
         return self.mu_b * self.l_b / 3.0 + tip
 
     def axial_damping(self, beam: str) -> float:
-        """Damping (g/s) on a beam's tip elongation u, MODEL.md §5 (ASSUMPTION).
+        """Damping (g/s) on a beam's tip elongation u, docs/model.md §5 (ASSUMPTION).
 
         c = 2 zeta sqrt(k m): the axial coordinate's own mode (stiffness
         EA/L, mass :meth:`axial_mass`) gets the beam's bending zeta.  Its

@@ -9,7 +9,7 @@
 The kernel (:func:`workbench.core.hybrid.run_hybrid`) runs in chunks, so
 memory stays bounded, progress can be shown, and a failure keeps every
 sample and event computed before it (``run.status``, ``run.message``).
-Units are CGS (MODEL.md); ``run.units`` names them per column.
+Units are CGS (docs/model.md); ``run.units`` names them per column.
 """
 from __future__ import annotations
 
@@ -27,6 +27,7 @@ from .excitation import none
 from .limits import MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD
 from ..study.metrics import contact_shares
 from .params import ParameterError, Parameters, check_positive
+from .regimes import contact_code, in_contact, is_stick, set_of
 from .statics import static_equilibrium, tip_load_for_deflection
 
 DEFAULT_OUTPUT_HZ = 1000.0
@@ -174,7 +175,7 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
 #: The smallest energy scale (erg) of :meth:`Run.energy_balance_rel`.
 ENERGY_SCALE_FLOOR_ERG = 1.0
 
-#: Run statistics of the contact logic reported by :meth:`Run.summary` (MODEL.md §7).
+#: Run statistics of the contact logic reported by :meth:`Run.summary` (docs/model.md §7).
 CONTACT_STAT_KEYS = ("accumulations", "accumulation_energy_lost_erg", "inconsistent_resolved",
                      "inconsistent_energy_lost_erg", "least_violated", "stepped_steps",
                      "stepped_energy_lost_erg", "s_min_cm", "s_max_cm")
@@ -241,7 +242,7 @@ class Run:
         return e
 
     def energy_balance_rel(self) -> float:
-        """Largest |residual| over the run's energy scale (MODEL.md §9).
+        """Largest |residual| over the run's energy scale (docs/model.md §9).
 
         The scale is the throughput |W_excitation| + dissipations at the end,
         plus the largest kinetic energy and the largest change of the
@@ -299,19 +300,6 @@ class Run:
         self.events.to_parquet(stem + ".events.parquet")
 
 
-def contact_code(regime: int) -> int:
-    """The paper's contact code (0, 1, 2, 3, 4, 13, 14, 23, 24) of a regime 0..16."""
-    return ly.CONTACT_CODE[(regime + 1) // 2]
-
-
-def regime_name(regime: int) -> str:
-    """'free', or e.g. 'stick {2,3}' / 'slip {1}'."""
-    if regime == 0:
-        return "free"
-    code = str(contact_code(regime))
-    return f"{'stick' if regime % 2 else 'slip'} {{{','.join(code)}}}"
-
-
 def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: float | None = None,
                   static=None, regime: int = 0):
     """The augmented initial state (N_AUG,), its regime (set, stick) and a label.
@@ -322,8 +310,8 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
     ``initial``: "static" (equilibrium under gravity), "paper" (undeformed,
     at rest, loose body centred, free flight, seed §2.3) or an 18-vector
     (q, q') in the regime ``regime`` (0..16, default free flight; the
-    kernel settles it, MODEL.md §7).  ``free_decay_cm`` deflects the tip
-    statically by that much first (MODEL.md §8 free decay; implies the
+    kernel settles it, docs/model.md §7).  ``free_decay_cm`` deflects the tip
+    statically by that much first (docs/model.md §8 free decay; implies the
     static start).
     """
     y = np.zeros(ly.N_AUG)
@@ -347,14 +335,14 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
     if not (isinstance(regime, (int, np.integer)) and 0 <= regime <= 16):
         raise ParameterError(f"regime = {regime!r} is outside the allowed range 0..16")
     y[:ly.N_STATE] = arr
-    return y, ((int(regime) + 1) // 2, regime % 2 == 1), "given"
+    return y, (set_of(int(regime)), is_stick(int(regime))), "given"
 
 
 def simulate(params: Parameters, excitation: np.ndarray | None = None, duration: float = 1.0, *,
              dt: float | None = None, output_hz: float = DEFAULT_OUTPUT_HZ, initial="static",
              free_decay_cm: float | None = None, fixed=(), progress: bool = False,
              t0: float = 0.0, regime: int = 0) -> Run:
-    """Simulate ``duration`` seconds of the loose-joint beam (MODEL.md §3-9).
+    """Simulate ``duration`` seconds of the loose-joint beam (docs/model.md §3-9).
 
     ``excitation`` is an array from :mod:`workbench.model.excitation` (default: none).
     ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
@@ -468,11 +456,10 @@ def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s,
     for j, name in enumerate(ly.SIGNALS):
         df[name] = sig[:, j]
     df["regime"] = df["regime"].astype(np.int16)
-    sets = (df["regime"].to_numpy() + 1) // 2
+    regimes = df["regime"].to_numpy()
     for k in range(ly.N_POINTS):
-        members = np.array([ly.SET_FIRST[s] == k or ly.SET_SECOND[s] == k for s in range(ly.N_SETS)])
-        df[f"contact{k + 1}"] = members[sets].astype(np.int8)
-    df["contact_code"] = np.array(ly.CONTACT_CODE, dtype=np.int16)[sets]
+        df[f"contact{k + 1}"] = in_contact(k, regimes)
+    df["contact_code"] = contact_code(regimes).astype(np.int16)
     df.index = pd.Index(t, name="t")
     events = pd.DataFrame({
         "t": logs[:, ly.LOG_T],

@@ -1,7 +1,7 @@
 """Static equilibrium of the rig under gravity and an optional tip load.
 
 The rig hangs before the shaker starts: the structure sags by centimetres
-and the loose body rests on the contacts that statics selects (MODEL.md §8;
+and the loose body rests on the contacts that statics selects (docs/model.md §8;
 with the tip mass, beam B pries the loose body into contact set {2, 3}).
 
 For each contact set the equations
@@ -35,6 +35,7 @@ from ..core.dynamics import energies, eval_rhs
 from ..core.kinematics import element_kinematics
 from .excitation import DYN_PER_N, none
 from .params import ParameterError, Parameters
+from .regimes import CONTACT_CODES, SETS
 
 _FORCE_SCALE = 1e5     # dyn: scales the force rows of the Newton residual
 _GAP_SCALE = 1e-3      # cm: scales the gap rows
@@ -56,7 +57,7 @@ class Equilibrium:
 
     @property
     def contact_code(self) -> int:
-        return ly.CONTACT_CODE[self.contact_set]
+        return CONTACT_CODES[self.contact_set]
 
 
 class _Statics:
@@ -100,7 +101,7 @@ class _Statics:
 
 def _unknowns(st: _Statics, set_index: int, hold_s: bool):
     coords = [i for i in st.free if not (hold_s and i == ly.S)]
-    points = [p for p in (ly.SET_FIRST[set_index], ly.SET_SECOND[set_index]) if p >= 0]
+    points = list(SETS[set_index])
     friction = hold_s and ly.S in st.free and set_index > 0
     return coords, points, friction
 

@@ -205,7 +205,7 @@ def strain_spectra(signals: pd.DataFrame, title: str, seconds: float | None = No
 
 def switching_diagram(events: pd.DataFrame, t_end: float, title: str, seconds: float = 0.5):
     """The contact code against time over the last ``seconds`` (paper Fig. 9)."""
-    from ..model.simulate import contact_code
+    from ..model.regimes import contact_code
 
     t0 = t_end - seconds
     t = events.t.to_numpy()

@@ -25,13 +25,15 @@ from . import figures as F
 from ..study.grid import point_title
 from ..study.provenance import environment
 from ..study.store import read_runs, write_text_atomic
+from ..model import drives
 from ..study.definition import Study
 from .tables import write_tables
 
 
 def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     has = {a for a in ("gap_mm", "freq_hz") if f"axis_{a}" in table and table[f"axis_{a}"].nunique() > 1}
-    sine = study.excitation["kind"] == "sine" and "freq_hz" in has
+    frequency = drives.DRIVES[study.excitation["kind"]].frequency_key
+    sine = frequency == "freq_hz" and "freq_hz" in has
     figs = {}
     if not (table.status == "ok").any():
         return figs
@@ -64,7 +66,7 @@ def _series_figures(study: Study, table: pd.DataFrame, out: Path):
         yield f"time_history_{tag}", lambda: F.time_history(sig, row.static_tip_y, title, short)
         yield f"strain_spectra_{tag}", lambda: F.strain_spectra(sig, title, study.window_s)
         yield f"switching_{tag}", lambda: F.switching_diagram(ev, t_end, title, short)
-        if study.excitation["kind"] == "chirp":
+        if drives.DRIVES[study.excitation["kind"]].swept:
             yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
 
 

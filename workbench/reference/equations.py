@@ -1,6 +1,6 @@
 """A slow, obviously-correct NumPy reference of the free-flight equations.
 
-Same physics as the kernels (MODEL.md §4-6), coded independently, for the
+Same physics as the kernels (docs/model.md §4-6), coded independently, for the
 tests (which check the kernels against it) and the benchmarks (the paper's
 method, :mod:`workbench.reference.events`):
 
@@ -90,7 +90,7 @@ def rotate(angle, px, py):
 
 
 def hermite(xi, L):
-    """N1, N2 and their x-derivatives at xi = x/L (MODEL.md §4)."""
+    """N1, N2 and their x-derivatives at xi = x/L (docs/model.md §4)."""
     return (3 * xi ** 2 - 2 * xi ** 3, L * (xi ** 3 - xi ** 2),
             6 * (xi - xi ** 2) / L, 3 * xi ** 2 - 2 * xi)
 
@@ -151,7 +151,7 @@ class Reference:
             omega1 = 3.516 / L ** 2 * np.sqrt(E * I / mu)
             K[i0:i0 + 3, i0:i0 + 3] = blk
             C[i0:i0 + 2, i0:i0 + 2] = 2 * zeta / omega1 * blk[:2, :2]
-            # the axial coordinate's own mode at the same zeta (MODEL.md §5)
+            # the axial coordinate's own mode at the same zeta (docs/model.md §5)
             C[i0 + 2, i0 + 2] = 2 * zeta * np.sqrt(blk[2, 2] * p.axial_mass("a" if i0 == 0 else "b"))
         K[4, 4] = p.k_v
         K[5, 5] = p.k_psi
@@ -198,7 +198,7 @@ class Reference:
         return M, h, Qg, Vg
 
     def cork(self, s, sd):
-        """Cork spring and damper plus the slot's end stop (MODEL.md §6)."""
+        """Cork spring and damper plus the slot's end stop (docs/model.md §6)."""
         n, k, c = self.p.cork_law
         over = max(abs(s) - self.p.s_travel, 0.0)
         return k * np.sign(s) * abs(s) ** n + self.p.k_stop * np.sign(s) * over + c * sd
@@ -243,7 +243,7 @@ class Reference:
 
 
 def shaker(ex):
-    """The shaker force F(t) (dyn) of a workbench excitation array (MODEL.md §8).
+    """The shaker force F(t) (dyn) of a workbench excitation array (docs/model.md §8).
 
     Sine F0 sin(2 pi f t) or linear chirp F0 sin(2 pi (f0 t + (f1 - f0) t^2 / 2T)),
     times the soft start 1/2 (1 - cos(pi t / t_ramp)) before t_ramp; written

@@ -1,4 +1,4 @@
-"""The paper's method: the contact model (MODEL.md §7) by an adaptive solver with restarts.
+"""The paper's method: the contact model (docs/model.md §7) by an adaptive solver with restarts.
 
 Seed §2.3: integrate one regime with an adaptive solver (LSODA, as the
 paper did, or any other method of scipy's solve_ivp) until a terminal
@@ -6,14 +6,14 @@ event, apply the transition, restart.  Slow, and coded independently of
 the kernels, so that the tests check the kernels against it and the
 benchmarks measure the kernels against it (benchmarks/):
 
-* gaps and tangential coordinates are the formulas of MODEL.md §7 evaluated
+* gaps and tangential coordinates are the formulas of docs/model.md §7 evaluated
   on the jets of :mod:`workbench.reference.equations` (no hand-derived
   gradient or Hessian);
 * each regime is solved as the dense KKT system
   [[M, -B^T], [A, 0]] [q'', lambda] = [Q - h, -A' q'] by numpy.linalg.solve;
 * events are scipy's terminal events, located on the dense output.
 
-The transition *rules* are those of MODEL.md §7 and the kernel's: the same
+The transition *rules* are those of docs/model.md §7 and the kernel's: the same
 impact law (:func:`workbench.core.impact_law.eval_impact`, on Delassus
 matrices built here from the jets), the same enumeration of regimes in the
 same order with the same tolerances, per-point friction when slipping and
@@ -30,13 +30,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.linalg import null_space
 
-from ..core.config import FRICTION_REL_EPS, GAP_EPS, LAMBDA_EPS, RATE_EPS
+from ..core.config import (CLOSED_RATE, FRICTION_REL_EPS, GAP_EPS, GAP_TOL, LAMBDA_EPS, RATE_EPS,
+                           REGIME_REL_TOL, REST_RATE)
 from ..core.impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, eval_impact
-from ..core.transitions import CLOSED_RATE, GAP_TOL, REGIME_REL_TOL, REST_RATE
+from ..model.regimes import SETS, regime_of, set_of_points
 from .equations import N, Jet, Reference, jcos, jsin
 
-#: Contact sets (0-based points) in the order of MODEL.md §7; index = set number.
-SETS = ((), (0,), (1,), (2,), (3,), (0, 2), (0, 3), (1, 2), (1, 3))
 
 
 def _incompatible(points):
@@ -56,9 +55,8 @@ class Regime:
 
     @property
     def number(self):
-        """Regime number 0..16: 2k - 1 stick, 2k slip (MODEL.md §7)."""
-        k = self.set_index
-        return 0 if k == 0 else (2 * k - 1 if self.stick else 2 * k)
+        """Regime number 0..16: 2k - 1 stick, 2k slip (docs/model.md §7)."""
+        return regime_of(self.set_index, self.stick)
 
     @property
     def points(self):
@@ -71,7 +69,7 @@ class Regime:
 
 
 def set_number(points):
-    return SETS.index(tuple(sorted(points)))
+    return set_of_points(points)
 
 
 @dataclass
@@ -111,7 +109,7 @@ class HybridReference:
         self.rtol, self.atol, self.method = rtol, atol, method
         self._cache = (None, None)
 
-    # ---- geometry (MODEL.md §7, the formulas as written) -------------------------
+    # ---- geometry (docs/model.md §7, the formulas as written) -------------------------
     def contact(self, q, qd):
         """Jets of g1..g4 and tau1..tau4."""
         p = self.p
@@ -182,7 +180,7 @@ class HybridReference:
         return out
 
     def margin(self, t, y, reg):
-        """How far a sticking regime is inside the friction cone (dyn), as MODEL.md §7 reads.
+        """How far a sticking regime is inside the friction cone (dyn), as docs/model.md §7 reads.
 
         One point: mu_s lambda_n - |lambda_t|.  Two points: the width of the
         interval of splits alpha (along the unit null vector of the rows n1,
@@ -254,7 +252,7 @@ class HybridReference:
                 reg.points[0])
         return evs
 
-    # ---- transitions (MODEL.md §7) -------------------------------------------------
+    # ---- transitions (docs/model.md §7) -------------------------------------------------
     def closed_points(self, g, point, reg, gap_tol, rate_tol):
         """The event point, the regime's points, then the nearest open points within gap_tol.
 

@@ -42,22 +42,10 @@ from typing import Any
 
 import numpy as np
 
-from ..model import excitation as X
+from ..model import drives
 from ..model.limits import FREE_DECAY_MAX_CM, MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
-#: Excitation kinds and the keys each accepts (user units in the names).
-EXCITATION_KEYS = {
-    "none": (),
-    "sine": ("force_n", "freq_hz", "ramp_s"),
-    "chirp": ("force_n", "f0_hz", "f1_hz", "sweep_s", "ramp_s"),
-    "free_decay": ("deflection_cm",),
-    "hammer_joint": ("force_n", "width_s", "t_hit_s"),
-    "hammer_tip": ("force_n", "width_s", "t_hit_s"),
-}
-EXCITATION_DEFAULTS = {"force_n": X.DEFAULT_FORCE_N, "ramp_s": 0.0, "width_s": 1e-3,
-                       "t_hit_s": 0.0, "deflection_cm": 8.4}
-ALL_EXCITATION_KEYS = sorted({k for keys in EXCITATION_KEYS.values() for k in keys})
 SWEEP_MODES = ("independent", "up", "down", "up-down")
 STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz",
               "save_series", "initial"}
@@ -65,23 +53,6 @@ STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "o
 
 class StudyError(ParameterError):
     """A study file that cannot run (names the file, the key and what is allowed)."""
-
-
-def excitation_array(excitation: dict, first_in_chain: bool = True) -> np.ndarray:
-    """The kernel's excitation array of settings {"kind": ..., key: value} (user units,
-    every key of its kind present); a sine or chirp not first in a chain has no ramp."""
-    e = dict(excitation)
-    kind = e.pop("kind")
-    if kind in ("sine", "chirp") and not first_in_chain:
-        e["ramp_s"] = 0.0
-    if kind == "none" or kind == "free_decay":
-        return X.none()
-    if kind == "sine":
-        return X.sine(e["force_n"], e["freq_hz"], e["ramp_s"])
-    if kind == "chirp":
-        return X.chirp(e["force_n"], e["f0_hz"], e["f1_hz"], e["sweep_s"], e["ramp_s"])
-    builder = X.hammer_joint if kind == "hammer_joint" else X.hammer_tip
-    return builder(e["force_n"], e["width_s"], e["t_hit_s"])
 
 
 @dataclass(frozen=True)
@@ -97,17 +68,17 @@ class Point:
 
     def excitation_array(self, first_in_chain: bool = True) -> np.ndarray:
         """The kernel's excitation array (the soft start only on a chain's first point)."""
-        return excitation_array(self.excitation, first_in_chain)
+        return drives.excitation_array(self.excitation, first_in_chain)
 
     @property
-    def free_decay_cm(self):
-        return self.excitation.get("deflection_cm") if self.excitation["kind"] == "free_decay" \
-            else None
+    def start_keywords(self) -> dict:
+        """The keywords of simulate() that set the drive's start (a free decay's deflection)."""
+        return drives.start_keywords(self.excitation)
 
     @property
     def drive_hz(self):
-        """The forcing frequency (Hz) of a sine, else None."""
-        return self.excitation.get("freq_hz") if self.excitation["kind"] == "sine" else None
+        """The forcing frequency (Hz) of a drive that has one (a sine), else None."""
+        return drives.drive_hz(self.excitation)
 
 
 @dataclass(frozen=True)
@@ -207,8 +178,8 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
 
     exc = dict(data.get("excitation", {"kind": "none"}))
     kind = exc.pop("kind", None)
-    if kind not in EXCITATION_KEYS:
-        raise StudyError(f"[excitation] kind = {kind!r}; allowed: {sorted(EXCITATION_KEYS)}")
+    if kind not in drives.DRIVES:
+        raise StudyError(f"[excitation] kind = {kind!r}; allowed: {sorted(drives.DRIVES)}")
     fixed = dict(data.get("fixed", {}))
     axes = dict(data.get("axes", {}))
     for key, values in axes.items():
@@ -220,7 +191,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                                  f"string, got {_short(v)}")
         if len(set(map(_value_key, values))) != len(values):
             raise StudyError(f"[axes] {key} lists a value twice: {_short(values)}")
-    allowed_exc = set(EXCITATION_KEYS[kind])
+    allowed_exc = set(drives.DRIVES[kind].keys)
     for key, value in list(exc.items()) + list(fixed.items()):
         if not isinstance(value, (bool, int, float, str)):
             table = "excitation" if key in exc else "fixed"
@@ -233,7 +204,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                     raise StudyError(f"[fixed] {key} is an excitation setting: put it in "
                                      "[excitation] or [axes]")
                 continue
-            if key in ALL_EXCITATION_KEYS:
+            if key in drives.all_keys():
                 raise StudyError(f"[{table}] {key} does not apply to a {kind!r} excitation "
                                  f"(its settings: {sorted(allowed_exc)})")
             if table == "excitation":
@@ -243,12 +214,13 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     both = sorted(set(axes) & (set(fixed) | set(exc)))
     if both:
         raise StudyError(f"{both} given both as an axis and as a fixed value")
-    missing = sorted(k for k in allowed_exc - set(exc) - set(axes) - set(EXCITATION_DEFAULTS))
+    missing = sorted(k for k in allowed_exc - set(exc) - set(axes) - set(drives.DEFAULTS))
     if missing:
         raise StudyError(f"a {kind!r} excitation needs {missing} in [excitation] or [axes]")
-    if sweep != "independent" and (kind != "sine" or "freq_hz" not in axes):
-        raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a sine "
-                         "excitation with freq_hz in [axes]")
+    frequency = drives.DRIVES[kind].frequency_key
+    if sweep != "independent" and (frequency is None or frequency not in axes):
+        raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a drive "
+                         "with a forcing frequency (a sine) with that frequency in [axes]")
 
     names = list(axes)
     where = {"duration": "[study] duration_s", "dt": "[study] dt", "output_hz": "[study] output_hz"}
@@ -261,8 +233,8 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         try:
             params = Parameters.from_user(model_values)
             settings = {"kind": kind}
-            for k in EXCITATION_KEYS[kind]:
-                settings[k] = values.get(k, exc.get(k, EXCITATION_DEFAULTS.get(k)))
+            for k in drives.DRIVES[kind].keys:
+                settings[k] = values.get(k, exc.get(k, drives.DEFAULTS.get(k)))
             pt = Point(values=values, params=params, excitation=settings)
             _check_point(pt, duration, dt, output_hz, where)
         except StudyError:

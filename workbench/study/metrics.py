@@ -34,11 +34,11 @@ import math
 
 import numpy as np
 
-from ..core import layout as ly
+from ..model import regimes
 
 CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
 HARMONICS = (0.5, 1.0, 2.0, 3.0)
-CONTACT_CODES = tuple(int(c) for c in ly.CONTACT_CODE)
+CONTACT_CODES = regimes.CONTACT_CODES
 DISSIPATION = {"structural": "d_structural", "cork": "d_cork", "friction": "d_friction",
                "impact": "d_impact"}
 #: Printed names (with units) of the metrics shown in figures and tables.
@@ -111,13 +111,13 @@ def once_per_period(t: np.ndarray, x: np.ndarray, f_hz: float) -> np.ndarray:
 def regime_time(events, t0: float, t1: float) -> dict[int, float]:
     """Time (s) spent in each regime within [t0, t1], from the event log."""
     times = events.t.to_numpy()
-    regimes = events.to_regime.to_numpy()
+    to_regime = events.to_regime.to_numpy()
     out: dict[int, float] = {}
     for k in range(len(times)):
         start = max(times[k], t0)
         end = min(times[k + 1] if k + 1 < len(times) else t1, t1)
         if end > start:
-            out[int(regimes[k])] = out.get(int(regimes[k]), 0.0) + end - start
+            out[int(to_regime[k])] = out.get(int(to_regime[k]), 0.0) + end - start
     return out
 
 
@@ -128,7 +128,7 @@ def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
     """
     share: dict[str, float] = {}
     for reg, dur in regime_time(events, t0, t1).items():
-        code = str(ly.CONTACT_CODE[(reg + 1) // 2])
+        code = str(regimes.contact_code(reg))
         share[code] = share.get(code, 0.0) + dur
     total = t1 - t0
     return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}
@@ -167,8 +167,8 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
         out[f"share_{code}"] = 0.0
     stick = 0.0
     for reg, dur in spent.items():
-        out[f"share_{ly.CONTACT_CODE[(reg + 1) // 2]}"] += dur / total
-        if reg % 2 == 1:
+        out[f"share_{regimes.contact_code(reg)}"] += dur / total
+        if regimes.is_stick(reg):
             stick += dur / total
     out["stick_share"] = stick
     ev = run.events[(run.events.t >= t0) & (run.events.kind != "start")]
@@ -182,7 +182,7 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
 
 
 def contact_checks(run) -> dict:
-    """The contact logic's account of a run (MODEL.md §6-§7), for sweeps and the stress study.
+    """The contact logic's account of a run (docs/model.md §6-§7), for sweeps and the stress study.
 
     The run's contact statistics (accumulations, inconsistent states
     resolved, least-violated regimes, Moreau-Jean steps, with the energy

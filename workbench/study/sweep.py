@@ -98,7 +98,7 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> 
         run = simulate(point.params, point.excitation_array(first_in_chain=not continued),
                        study.duration_s, dt=study.dt, output_hz=study.output_hz,
                        initial=initial if continued else study.initial,
-                       free_decay_cm=point.free_decay_cm)
+                       **point.start_keywords)
         metrics = point_metrics(run, study.window_s, point.drive_hz) if run.ok else {}
         row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)

@@ -1,0 +1,84 @@
+"""The kernels' contract (README "Reading map"), checked on their source.
+
+``workbench/core`` holds numba kernels only: it imports numba, numpy and the
+standard library, never pandas, matplotlib, joblib or the rest of the
+package; every jit decorator takes its options from ``core/config.py``
+(``JIT`` or ``JIT_INLINE``: ``cache=True`` and the error model in one
+place); and the work arrays come in one order everywhere, that of
+:class:`workbench.model.packing.Work` after the model's arrays, so a
+swapped pair (all are 2-D float arrays) cannot compile silently.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+from workbench.core import config
+from workbench.model.packing import Model, Work
+
+CORE = Path(__file__).resolve().parent.parent / "workbench" / "core"
+SOURCES = sorted(CORE.glob("*.py"))
+#: What a kernel module may import (the cache module reaches into numba's caching).
+ALLOWED_IMPORTS = {"numba", "numpy", "math", "__future__", "hashlib", "os", "shutil", "pathlib"}
+#: The one order of the arrays a kernel takes: the model's, the drive, the work's.
+ARGUMENT_ORDER = [*Model._fields, "ex", *Work._fields]
+
+
+def _tree(path):
+    return ast.parse(path.read_text(), filename=str(path))
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda p: p.name)
+def test_core_imports_only_numba_numpy_and_the_standard_library(path):
+    for node in ast.walk(_tree(path)):
+        if isinstance(node, ast.Import):
+            roots = {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level == 1:            # from . import / from .x import: core itself
+                continue
+            assert node.level == 0, f"{path.name}:{node.lineno} imports from outside core"
+            roots = {node.module.split(".")[0]}
+        else:
+            continue
+        assert roots <= ALLOWED_IMPORTS, f"{path.name}:{node.lineno} imports {roots - ALLOWED_IMPORTS}"
+
+
+def _jit_decorators(tree):
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef):
+            for dec in node.decorator_list:
+                target = dec.func if isinstance(dec, ast.Call) else dec
+                name = ast.unparse(target)
+                if name.split(".")[-1] in ("njit", "jit", "vectorize", "guvectorize", "cfunc"):
+                    yield node, dec
+
+
+def test_every_jit_decorator_takes_the_config_options():
+    seen = 0
+    for path in SOURCES:
+        for fn, dec in _jit_decorators(_tree(path)):
+            seen += 1
+            where = f"{path.name}:{fn.name}"
+            assert isinstance(dec, ast.Call) and not dec.args, where
+            assert len(dec.keywords) == 1 and dec.keywords[0].arg is None, where   # **options only
+            assert ast.unparse(dec.keywords[0].value) in ("JIT", "JIT_INLINE", "JIT_PARALLEL"), where
+    assert seen > 50                                   # the kernels were found
+    assert config.JIT["cache"] is True and config.JIT_INLINE["cache"] is True
+
+
+def test_the_kernels_take_their_arrays_in_one_order():
+    checked = 0
+    for path in SOURCES:
+        for node in ast.walk(_tree(path)):
+            if not isinstance(node, ast.FunctionDef):
+                continue
+            names = [a.arg for a in node.args.args if a.arg in ARGUMENT_ORDER]
+            if len(names) < 2:
+                continue
+            checked += 1
+            positions = [ARGUMENT_ORDER.index(a) for a in names]
+            assert positions == sorted(positions), (f"{path.name}:{node.name} takes {names}; "
+                                                    f"the order is {ARGUMENT_ORDER}")
+    assert checked > 30
