@@ -20,7 +20,7 @@ the loose body relative to the joint body along the contact, outward):
 
 They depend on (s, v, psi) only.  :func:`fill_geometry` writes each value
 with its hand-derived gradient and Hessian (tested against finite
-differences in tests/test_contact.py) into the record ``cg`` (layout
+differences in tests/core/test_contact.py) into the record ``cg`` (layout
 ``CG_*``).
 """
 import math

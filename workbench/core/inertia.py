@@ -18,7 +18,7 @@ with m, c = sum m rho and I_rho = sum m |rho|^2 of the frame's points, and
 likewise for h, gravity and the rotary inertia (the angle row of an element
 is a + d, d its own slope terms).  So each element adds a few local sums,
 and the 9 x 9 work is done once per frame.  Results equal the element sums
-to round-off (``tests/test_dynamics.py`` checks them against the
+to round-off (``tests/core/test_dynamics.py`` checks them against the
 independent reference).
 """
 import numba as nb

@@ -18,7 +18,7 @@ import pytest
 from workbench.core import config
 from workbench.model.packing import Model, Work
 
-CORE = Path(__file__).resolve().parent.parent / "workbench" / "core"
+CORE = Path(__file__).resolve().parents[2] / "workbench" / "core"
 SOURCES = sorted(CORE.glob("*.py"))
 #: What a kernel module may import (the cache module reaches into numba's caching).
 ALLOWED_IMPORTS = {"numba", "numpy", "math", "__future__", "hashlib", "os", "shutil", "pathlib"}

@@ -160,7 +160,7 @@ def test_trajectory_agrees_with_solve_ivp_reference(fixed, duration):
 @pytest.mark.parametrize("seed", range(3))
 def test_frame_sums_equal_the_element_sums(seed, tip):
     """core/inertia.py regroups sum m J^T J + I a a^T, sum m J^T kappa and gravity by frame:
-    equal to the sums over the elements (kinematics of tests/test_kinematics.py) to round-off."""
+    equal to the sums over the elements (kinematics of tests/core/test_kinematics.py) to round-off."""
     from test_kinematics import kinematics
 
     p = Parameters(tip_mass=tip)
