@@ -320,10 +320,11 @@ def test_fuzzed_experiment_files_never_crash(cut, junk, files, capsys):
 
 COMMANDS = [["sweep", "S", "--dry-run"], ["compare", "R"], ["estimate", "R", "--fit", "e_b=6e11"],
             ["modes"], ["params"], ["identify", "decrement", "1", "0.5", "0", "1", "5"],
-            ["identify", "tables", "--no-table6"]]
+            ["identify", "tables", "--no-table6"], ["frf", "R"]]
 MORE_OPTIONS = OPTIONS + ["--jobs", "--scheduler", "--results", "--fresh", "--skip-s",
                           "--strain-scale", "--threshold", "--fit", "--max-nfev", "--beam",
-                          "--joint", "--params", "--json"]
+                          "--joint", "--params", "--json", "--force", "--response", "--segment-s",
+                          "--f-min", "--f-max"]
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=list(HealthCheck))

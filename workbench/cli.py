@@ -453,6 +453,53 @@ def _cmd_compare(args) -> int:
     return 0 if run.ok else 1
 
 
+def _cmd_frf(args) -> int:
+    import numpy as np
+    import pandas as pd
+
+    from .experiments.frf import frf, peaks
+    from .present.figures import frf_figure, save
+
+    path = Path(args.file)
+    if path.suffix == ".parquet":
+        if not path.is_file():
+            raise ParameterError(f"{args.file}: no such file")
+        try:
+            record = pd.read_parquet(path)
+        except (OSError, ValueError) as exc:      # missing, unreadable, not Parquet
+            raise ParameterError(f"{args.file}: cannot be read as Parquet ({_one_line(exc)})") from None
+        if not pd.api.types.is_numeric_dtype(record.index) or len(record) < 2:
+            raise ParameterError(f"{args.file}: not a run's signals (indexed by time, s)")
+    else:
+        record = _read_record(args, args.file)
+    _check_window(args.file, record, args.skip_s)
+    out = check_output_dir("--out", args.out or Path("results") / "frf" / path.stem)
+    out.mkdir(parents=True, exist_ok=True)
+    table = frf(record, args.response or None, force=args.force, segment_s=args.segment_s,
+                skip_s=args.skip_s)
+    responses = sorted({c.rsplit("_", 1)[0] for c in table.columns})
+    flat = pd.DataFrame(index=table.index)
+    for r in responses:
+        for est in ("H1", "H2"):
+            flat[f"{r}_{est}_abs"] = table[f"{r}_{est}"].abs()
+            flat[f"{r}_{est}_phase_deg"] = np.degrees(np.angle(table[f"{r}_{est}"]))
+        flat[f"{r}_coherence"] = table[f"{r}_coherence"]
+    flat.to_csv(out / "frf.csv")
+    rows = [peaks(table, r, args.f_min, args.f_max).assign(response=r) for r in responses]
+    peak_table = pd.concat(rows, ignore_index=True)[["response", "f_hz", "magnitude", "coherence",
+                                                      "zeta_half_power"]]
+    peak_table.to_csv(out / "peaks.csv", index=False)
+    (out / "peaks.md").write_text("# FRF peaks (H1): frequency, magnitude, coherence, half-power "
+                                  "damping ratio\n\n" + peak_table.to_markdown(index=False, floatfmt=".4g")
+                                  + "\n")
+    figures = save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against "
+                              f"{args.force}", args.f_max), out / "frf")
+    print(json_text({"record": args.file, "out": str(out), "resolution_hz": float(table.index[1]),
+                     "figures": [str(p) for p in figures if p.suffix == ".png"],
+                     "peaks": peak_table.to_dict("records")}))
+    return 0
+
+
 def _cmd_estimate(args) -> int:
     from .experiments.estimate import estimate
     from .experiments.matching import setup_from
@@ -559,6 +606,22 @@ def build_parser() -> argparse.ArgumentParser:
                          help="contact patch voltage that counts as touched (V)")
     compare.add_argument("--out", help="output folder (default results/compare/<file stem>)")
     compare.set_defaults(func=_cmd_compare)
+
+    fr = sub.add_parser("frf", help="H1, H2 and coherence of a record or a run against its force")
+    fr.add_argument("file", help="a .lvm or tab-delimited record, or a run's .parquet (workbench run --out)")
+    fr.add_argument("--force", default="force1", help="the force channel (default force1)")
+    fr.add_argument("--response", action="append", default=[],
+                    help="a response channel, repeatable (default: every accel and strain)")
+    fr.add_argument("--segment-s", type=_number(0, lo_open=True), default=2.0,
+                    help="Welch segment (s): the frequency resolution is 1/segment (default 2)")
+    fr.add_argument("--skip-s", type=_number(0), default=0.0, help="leave out the first seconds")
+    fr.add_argument("--f-min", type=_number(0), default=0.0, help="lowest peak frequency (Hz)")
+    fr.add_argument("--f-max", type=_number(0, lo_open=True), default=None,
+                    help="highest frequency shown and searched for peaks (Hz)")
+    fr.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
+                    help="scale factor of a strain channel recorded in V (strain per volt)")
+    fr.add_argument("--out", help="output folder (default results/frf/<file stem>)")
+    fr.set_defaults(func=_cmd_frf)
 
     est = sub.add_parser("estimate", help="fit model parameters to measurement files (§7.2)")
     est.add_argument("files", nargs="+", help="records (.lvm or tab-delimited)")

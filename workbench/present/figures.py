@@ -294,3 +294,28 @@ def code_series_diagrams(codes: dict[str, pd.Series], title: str, seconds: float
     axes[0, 0].set_title(title, fontsize=9)
     axes[-1, 0].set_xlabel("time (s)")
     return fig
+
+
+def frf_figure(table: pd.DataFrame, responses, title: str, f_max: float | None = None):
+    """|H1| and |H2|, the phase of H1 and the coherence of each response (one column each)."""
+    f = table.index.to_numpy()
+    band = (f > 0) & (f <= (f_max if f_max is not None else f[-1]))
+    fig, axes = plt.subplots(3, len(responses), figsize=(4.2 * len(responses), 7.5), sharex=True,
+                             squeeze=False, gridspec_kw={"height_ratios": [2, 1, 1]})
+    for j, r in enumerate(responses):
+        h1, h2 = table[f"{r}_H1"].to_numpy()[band], table[f"{r}_H2"].to_numpy()[band]
+        ax = axes[0, j]
+        ax.semilogy(f[band], np.abs(h1), label="H1")
+        ax.semilogy(f[band], np.abs(h2), label="H2", alpha=0.7)
+        ax.set_title(r, fontsize=9)
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3, which="both")
+        axes[1, j].plot(f[band], np.degrees(np.angle(h1)), lw=0.8)
+        axes[1, j].set_ylabel("phase H1 (deg)")
+        axes[2, j].plot(f[band], table[f"{r}_coherence"].to_numpy()[band], lw=0.8)
+        axes[2, j].set_ylim(0, 1.05)
+        axes[2, j].set_ylabel("coherence")
+        axes[2, j].set_xlabel("frequency (Hz)")
+    axes[0, 0].set_ylabel("|H| (response unit / force unit)")
+    fig.suptitle(title, fontsize=10)
+    return fig

@@ -1,0 +1,122 @@
+"""Frequency-response functions as the field defines them: H1, H2 and the coherence.
+
+For a force f and a response x sampled together (a record, measured or
+simulated), with Welch's averaged cross- and auto-spectra over segments
+(Bendat & Piersol, Random Data, 4th ed., §9.1):
+
+    H1 = G_fx / G_ff          (least noise on the response)
+    H2 = G_xx / G_xf          (least noise on the force)
+    gamma^2 = |G_fx|^2 / (G_ff G_xx) = H1 / H2
+
+A chirp, a sine sweep or a train of hammer hits fills the segments with
+force over the band; the coherence says where the record's response is
+linear in the force (near 1) and where it is not (the joint's impacts,
+noise).  Spectra come from scipy.signal's ``csd`` and ``welch`` (Hann
+window, half-overlapping segments): pyFRF averages separate records given
+one at a time, while a single long record, the workbench's and the lab's
+usual case, is averaged by segmenting it, which Welch's method does.
+
+The peaks of |H1| give the natural frequencies and, by the half-power
+bandwidth, the damping ratios: zeta = (f_b - f_a) / (2 f_n) with
+|H1(f_a)| = |H1(f_b)| = |H1(f_n)| / sqrt 2 (interpolated linearly).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy import signal
+
+from ..model.params import ParameterError
+
+#: Default segment length (s): 0.5 Hz resolution, enough to separate the modes.
+DEFAULT_SEGMENT_S = 2.0
+
+
+def frf(record: pd.DataFrame, responses=None, force: str = "force1",
+        segment_s: float = DEFAULT_SEGMENT_S, skip_s: float = 0.0) -> pd.DataFrame:
+    """H1, H2 and the coherence of each response channel against the force.
+
+    ``record`` is indexed by time (s) with the force column (N or dyn: the
+    FRF carries the ratio of the units) and the responses (default: every
+    accel and strain column).  Returns a DataFrame indexed by frequency
+    (Hz) with, per response r, the columns ``r_H1``, ``r_H2`` (complex)
+    and ``r_coherence``.  Raises ParameterError on a record it cannot use.
+    """
+    try:
+        t = record.index.to_numpy(dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError("the record's index must be its time (s)") from None
+    if force not in record:
+        raise ParameterError(f"the record has no {force} column (its columns: "
+                             f"{', '.join(map(str, record.columns))})")
+    if responses is None:
+        responses = [c for c in record.columns if str(c).startswith(("accel", "strain"))]
+    missing = [r for r in responses if r not in record]
+    if missing or not responses:
+        raise ParameterError(f"response channel(s) {missing or '(none)'} not in the record")
+    keep = t >= t[0] + skip_s - 1e-12
+    t = t[keep]
+    if len(t) < 16:
+        raise ParameterError(f"the record has {len(t)} samples after skip_s = {skip_s:g} s; "
+                             "need at least 16")
+    dt = np.diff(t)
+    if not (np.all(np.isfinite(t)) and dt[0] > 0 and np.allclose(dt, dt[0], rtol=1e-6)):
+        raise ParameterError("the record's time base is not uniform and increasing")
+    for c in [force, *responses]:
+        if not np.all(np.isfinite(record[c].to_numpy(dtype=float)[keep])):
+            raise ParameterError(f"the {c} column has values that are not finite")
+    fs = 1.0 / dt[0]
+    nperseg = min(len(t), max(16, int(round(segment_s * fs))))
+    f_in = record[force].to_numpy(dtype=float)[keep]
+    if not np.any(f_in):
+        raise ParameterError(f"the {force} column is zero: no force to refer the response to")
+    kw = dict(fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2, detrend="constant")
+    freq, g_ff = signal.welch(f_in, **kw)
+    out = {}
+    for r in responses:
+        x = record[r].to_numpy(dtype=float)[keep]
+        _, g_fx = signal.csd(f_in, x, **kw)           # E[F* X]
+        _, g_xx = signal.welch(x, **kw)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            h1 = g_fx / g_ff
+            h2 = g_xx / np.conj(g_fx)
+            coh = np.abs(g_fx) ** 2 / (g_ff * g_xx)
+        out[f"{r}_H1"] = h1
+        out[f"{r}_H2"] = h2
+        out[f"{r}_coherence"] = np.clip(np.nan_to_num(coh.real), 0.0, 1.0)
+    return pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
+
+
+def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: float | None = None,
+          prominence: float = 0.1, estimate: str = "H1") -> pd.DataFrame:
+    """The resonance peaks of |H| of one response: frequency (Hz), |H|, coherence, and the
+    half-power damping ratio (NaN where a half-power point lies outside the band).
+
+    ``prominence`` is relative to the largest |H| in the band (log scale: a
+    peak must stand out by that fraction of a decade)."""
+    f = frf_table.index.to_numpy()
+    band = (f >= f_min) & (f <= (f_max if f_max is not None else f[-1])) & (f > 0)
+    mag = np.abs(frf_table[f"{response}_{estimate}"].to_numpy())[band]
+    coh = frf_table[f"{response}_coherence"].to_numpy()[band]
+    fb = f[band]
+    if not np.any(mag > 0):
+        return pd.DataFrame(columns=["f_hz", "magnitude", "coherence", "zeta_half_power"])
+    logm = np.log10(np.where(mag > 0, mag, mag[mag > 0].min()))
+    idx, _ = signal.find_peaks(logm, prominence=prominence)
+    rows = []
+    for i in idx:
+        level = mag[i] / np.sqrt(2.0)
+        lo = i
+        while lo > 0 and mag[lo] > level:
+            lo -= 1
+        hi = i
+        while hi < len(mag) - 1 and mag[hi] > level:
+            hi += 1
+        zeta = np.nan
+        if mag[lo] <= level and mag[hi] <= level and lo < i < hi:
+            fa = np.interp(level, [mag[lo], mag[lo + 1]], [fb[lo], fb[lo + 1]])
+            fbb = np.interp(level, [mag[hi], mag[hi - 1]], [fb[hi], fb[hi - 1]])
+            zeta = (fbb - fa) / (2.0 * fb[i])
+        rows.append({"f_hz": float(fb[i]), "magnitude": float(mag[i]),
+                     "coherence": float(coh[i]), "zeta_half_power": float(zeta)})
+    return pd.DataFrame(rows, columns=["f_hz", "magnitude", "coherence", "zeta_half_power"])
