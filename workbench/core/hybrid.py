@@ -51,7 +51,6 @@ from .sensors import fill_signals
 from .transitions import choose_regime, impact, moreau_jean_step
 
 
-
 @nb.njit(**JIT)
 def event_values(y, P, free, cg, rg, ev, row, rate_row):
     """Event functions of the regime in rg at y into ev[row] (gap rates into ev[rate_row]).
@@ -146,8 +145,8 @@ def _hermite_min(f0, f1, m0, m1):
 
 
 @nb.njit(**JIT)
-def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-           ev):
+def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+           rg, ev):
     """Does gap event e dip below zero inside the step though it is positive at both ends?
 
     The gap turns within the step (slopes m0 < 0 < m1 per unit theta).  The
