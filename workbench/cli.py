@@ -231,21 +231,32 @@ RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--outp
 
 
 def _cmd_run(args) -> int:
+    from .model import drives
     from .model.simulate import check_settings, simulate
-    n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse))
+    n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse,
+                                           args.drive))
     if n_drives > 1:
-        raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse")
+        raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse, --drive")
+    if args.drive_set and args.drive is None:
+        raise ParameterError("--drive-set sets a --drive: give --drive KIND")
     p = _parameters(args)
-    if args.ramp_s is None and (args.freq_hz is not None or args.chirp is not None):
-        args.ramp_s = min(DEFAULT_RAMP_S, 0.5 * args.duration)
-    ex = _excitation(args)
+    names = dict(RUN_OPTION_NAMES)
+    if args.drive is not None:
+        settings = _drive_settings(args)
+        ex = drives.excitation_array(settings)
+        start = drives.start_keywords(settings)
+        names.update({key: f"--drive-set {key}" for key in settings if key != "kind"})
+    else:
+        if args.ramp_s is None and (args.freq_hz is not None or args.chirp is not None):
+            args.ramp_s = min(DEFAULT_RAMP_S, 0.5 * args.duration)
+        ex = _excitation(args)
+        start = {"free_decay_cm": args.free_decay}
     check_settings(p, ex if ex is not None else _excitation_none(), args.duration,
-                   args.dt, args.output_hz, names=RUN_OPTION_NAMES)
+                   args.dt, args.output_hz, names=names)
     if args.out:
         check_output_file("--out", args.out, (".parquet",))
     run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
-                   initial=args.initial, free_decay_cm=args.free_decay,
-                   progress=not args.json and sys.stderr.isatty())
+                   initial=args.initial, progress=not args.json and sys.stderr.isatty(), **start)
     if args.out:
         run.to_parquet(args.out)
     summary = run.summary()
@@ -353,6 +364,33 @@ def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") ->
     drive.add_argument("--ramp-s", type=_number(0), help=ramp_help)
     drive.add_argument("--pulse-s", type=_number(0, lo_open=True), default=1e-3, help="hammer pulse duration (s)")
     drive.add_argument("--hit-s", type=_number(0), default=0.01, help="hammer pulse start (s)")
+    drive.add_argument("--drive", metavar="KIND",
+                       help="any registered drive (workbench/model/drives.py), set by --drive-set")
+    drive.add_argument("--drive-set", metavar="KEY=VALUE", action="append", default=[],
+                       help="a setting of --drive in its units (e.g. freq_hz=20), repeatable")
+
+
+def _drive_settings(args) -> dict:
+    """The settings {"kind": ..., key: value} of ``--drive`` and its ``--drive-set`` pairs."""
+    from .model import drives
+    drive = drives.get(args.drive, where="--drive")
+    given = _pair_numbers(args.drive_set, "--drive-set", "VALUE")
+    unknown = sorted(set(given) - set(drive.keys))
+    if unknown:
+        raise ParameterError(f"--drive-set {_cut(unknown[0])}: not a setting of --drive "
+                             f"{drive.kind} (its settings: {', '.join(drive.keys) or 'none'})")
+    settings = {"kind": drive.kind}
+    for key in drive.keys:
+        if key in given:
+            settings[key] = given[key]
+        elif key == "ramp_s" and drive.ramped and hasattr(args, "duration"):
+            settings[key] = min(DEFAULT_RAMP_S, 0.5 * args.duration)
+        elif key in drives.DEFAULTS:
+            settings[key] = drives.DEFAULTS[key]
+        else:
+            raise ParameterError(f"--drive {drive.kind} needs --drive-set {key}=VALUE "
+                                 f"({drives.UNITS[key]})")
+    return settings
 
 
 def _record_settings(args, meta: dict) -> dict:
@@ -374,6 +412,9 @@ def _record_settings(args, meta: dict) -> dict:
         drive = {"drive": "free_decay", "deflection_cm": args.free_decay}
     elif args.impulse is not None:
         drive = {"drive": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
+    elif args.drive is not None:
+        settings_of_drive = _drive_settings(args)
+        drive = {"drive": settings_of_drive.pop("kind"), **settings_of_drive}
     if drive:                  # a drive given here replaces the file's (its amplitude may stay)
         for key in set(drives.all_keys()) - {"force_n", "ramp_s"} | {"drive"}:
             settings.pop(key, None)

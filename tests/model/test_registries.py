@@ -105,3 +105,22 @@ def test_a_cork_law_is_one_entry_of_the_table(monkeypatch):
     soft = natural_frequencies(p, "free")
     assert soft[soft > 0].min() < stiff[stiff > 0].min()       # a softer spring on s
     assert build_parser().parse_args(["run", "--cork", "soft"]).cork == "soft"
+
+
+def test_the_command_line_runs_a_registered_drive(sine_rms, capsys):
+    import json
+
+    from workbench import cli
+
+    argv = ["run", "--drive", "sine_rms", "--drive-set", "freq_hz=20", "--drive-set", "force_n=3",
+            "--duration", "0.05", "--json"]
+    assert cli.main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["status"] == "ok"
+    for bad, words in ((["run", "--drive", "square"], "--drive = 'square'; allowed"),
+                       (["run", "--drive", "sine_rms", "--drive-set", "volts=3"],
+                        "--drive-set volts: not a setting of --drive sine_rms"),
+                       (["run", "--drive", "sine_rms"], "needs --drive-set freq_hz=VALUE (Hz)"),
+                       (["run", "--drive-set", "freq_hz=3"], "give --drive KIND")):
+        assert cli.main(bad) == cli.EXIT_BAD_INPUT
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and words in err, err
