@@ -11,7 +11,7 @@
                                      # (each selector names axis values; {} selects every point)
 
     [excitation]
-    kind = "sine"                    # sine | chirp | free_decay | hammer_joint | hammer_tip | none
+    kind = "sine"                    # a drive of model/drives.py: sine, chirp, free_decay, hammer_joint, hammer_tip, none
     force_n = 20.0
     ramp_s = 1.0                     # soft start (s)
 
