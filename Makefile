@@ -53,11 +53,11 @@ stress: $(foreach s,$(STRESS),$(RESULTS)/$(s)/report.md)  ## the stress studies:
 $(RESULTS)/modes/modes.md: $(STAMP) studies/modes.py $(SOURCES)
 	$(PY) studies/modes.py --out $(RESULTS)/modes
 
-# The paper's Tables 3-6 and Appendix B reproduced (issue 5).
+# The paper's Tables 3-6 and Appendix B reproduced.
 $(RESULTS)/identification/identification.md: $(STAMP) $(SOURCES)
 	$(PY) -m workbench identify tables --out $(RESULTS)/identification
 
-# The parameter estimator on synthetic .lvm records with hidden values (issue 5).
+# The parameter estimator on synthetic .lvm records with hidden values.
 $(RESULTS)/estimate/estimate.md: $(STAMP) studies/estimate_demo.py $(SOURCES)
 	$(PY) studies/estimate_demo.py --out $(RESULTS)/estimate
 
