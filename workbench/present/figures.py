@@ -209,7 +209,7 @@ def switching_diagram(events: pd.DataFrame, t_end: float, title: str, seconds: f
 
     t0 = t_end - seconds
     t = events.t.to_numpy()
-    codes = np.array([contact_code(int(r)) for r in events.to_regime])
+    codes = np.asarray(contact_code(events.to_regime.to_numpy(dtype=int)))
     start = max(np.searchsorted(t, t0, side="right") - 1, 0)     # the regime in force at t0
     tt = np.concatenate([[t0], t[start + 1:], [t_end]])
     cc = np.concatenate([codes[start:], codes[-1:]])
