@@ -89,6 +89,7 @@ CASES = [
     (["run", "--set", "cork=[1]"], ["--set cork=[1]", "cork"]),
     (["run", "--set", "gap_mm=1" + "0" * 400], ["--set gap_mm=1000", "too large"]),
     (["run", "--duration", "1e308"], ["--duration", "1e308"]),
+    (["frf", "R", "--segment-s", "1e308"], ["--segment-s", "1e+308", "allowed"]),
     (["run", "--dt", "1e-300"], ["--dt", "1e-300"]),
     (["run", "--dt", "1e-3"], ["--dt", "stability limit"]),
     (["run", "--dt", "abc"], ["--dt", "'abc'"]),
@@ -330,6 +331,7 @@ MORE_OPTIONS = OPTIONS + ["--jobs", "--scheduler", "--results", "--fresh", "--sk
 @settings(max_examples=200, deadline=None, suppress_health_check=list(HealthCheck))
 @given(command=st.sampled_from(COMMANDS),
        pairs=st.lists(st.tuples(st.sampled_from(MORE_OPTIONS), texts), min_size=1, max_size=3))
+@example(command=["frf", "R"], pairs=[("--segment-s", "1e308")])   # longer than the record
 def test_fuzzed_options_of_every_command_never_crash(command, pairs, files, capsys):
     argv = _fill(command, files) + [x for pair in pairs for x in pair
                                     if not (pair[0] == "--scheduler" and ":" in x)]

@@ -514,6 +514,11 @@ def _cmd_frf(args) -> int:
     else:
         record = _read_record(args, args.file)
     _check_window(args.file, record, args.skip_s)
+    t = record.index.to_numpy()
+    length = (t[-1] - t[0] - args.skip_s) * len(t) / max(len(t) - 1, 1)    # samples x dt
+    if args.segment_s > length * (1 + 1e-9):
+        raise ParameterError(f"--segment-s {args.segment_s:g}: longer than {args.file} after "
+                             f"--skip-s; allowed: (0, {length:g}] s")
     out = check_output_dir("--out", args.out or Path("results") / "frf" / path.stem)
     out.mkdir(parents=True, exist_ok=True)
     table = frf(record, args.response or None, force=args.force, segment_s=args.segment_s,

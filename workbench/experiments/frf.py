@@ -66,6 +66,9 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
         if not np.all(np.isfinite(record[c].to_numpy(dtype=float)[keep])):
             raise ParameterError(f"the {c} column has values that are not finite")
     fs = 1.0 / dt[0]
+    if not 0.0 < segment_s <= len(t) / fs:
+        raise ParameterError(f"segment_s = {segment_s:g} s: allowed (0, {len(t) / fs:g}] s, the "
+                             "record's length after skip_s")
     nperseg = min(len(t), max(16, int(round(segment_s * fs))))
     f_in = record[force].to_numpy(dtype=float)[keep]
     if not np.any(f_in):
