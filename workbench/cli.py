@@ -2,10 +2,12 @@
 
     workbench run --gap-mm G --tip-mass on|off --cork MODEL
                   [--freq-hz F | --chirp F0:F1:T | --free-decay CM | --impulse joint|tip]
-                  [--force-n A] [--mu M] [--duration T] [--dt DT] [--out FILE.parquet] [--json]
+                  [--force-n A] [--mu M] [--duration T] [--dt DT] [--out FILE] [--json]
     workbench modes [--tip-mass on|off] [--joint locked|free] [--cork MODEL] [--json]
     workbench params [--json]
     workbench compare FILE [model and drive options] [--skip-s S] [--out DIR]
+    workbench frf FILE [--response CH]... [--segment-s S] [--out DIR]
+    workbench convert SOURCE TARGET [--from FORMAT] [--to FORMAT]
     workbench estimate FILE... --fit NAME=START ... [model and drive options]
     workbench identify tables [--out DIR] | identify decrement X1 XN T1 TN N [--beam a|b]
 
@@ -205,23 +207,42 @@ def _chirp(text: str) -> tuple[float, float, float]:
         raise argparse.ArgumentTypeError(f"{text!r}: {exc} (F0:F1:T, each > 0)") from None
 
 
-def _excitation(args):
-    from .model import excitation as X
-    force = X.DEFAULT_FORCE_N if args.force_n is None else args.force_n
-    if args.force_n is not None and args.force_n < 0 and args.impulse is None:
+def _shortcut_drive(args) -> dict | None:
+    """The drive of --freq-hz, --chirp, --free-decay, --impulse or --drive, as settings
+    {"kind": ..., key: value} with the keys those options give; None without a drive."""
+    if args.freq_hz is not None:
+        return {"kind": "sine", "freq_hz": args.freq_hz}
+    if args.chirp is not None:
+        return dict(zip(("kind", "f0_hz", "f1_hz", "sweep_s"), ("chirp", *args.chirp)))
+    if args.free_decay is not None:
+        return {"kind": "free_decay", "deflection_cm": args.free_decay}
+    if args.impulse is not None:
+        return {"kind": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
+    if args.drive is not None:
+        return _drive_settings(args)
+    return None
+
+
+def _run_drive(args) -> dict:
+    """The complete drive settings of ``workbench run`` (amplitude and soft start filled)."""
+    from .model import drives, excitation as X
+    drive = _shortcut_drive(args) or {"kind": "none"}
+    if args.drive is not None:
+        return drive
+    hammer = args.impulse is not None
+    if args.force_n is not None and args.force_n < 0 and not hammer:
         raise ParameterError(f"--force-n {args.force_n:g}: a shaker amplitude must be >= 0 N "
                              "(a hammer's sign gives its direction)")
     if args.free_decay is not None and args.force_n is not None:
         raise ParameterError("--force-n does not apply to --free-decay (a release without drive)")
-    if args.freq_hz is not None:
-        return X.sine(force, args.freq_hz, ramp_s=args.ramp_s)
-    if args.chirp is not None:
-        return X.chirp(force, *args.chirp, ramp_s=args.ramp_s)
-    if args.impulse is not None:
-        hammer = X.hammer_joint if args.impulse == "joint" else X.hammer_tip
-        peak = X.DEFAULT_HAMMER_N if args.force_n is None else args.force_n
-        return hammer(peak, args.pulse_s, args.hit_s)
-    return None
+    keys = drives.get(drive["kind"]).keys
+    if "force_n" in keys:
+        default = X.DEFAULT_HAMMER_N if hammer else X.DEFAULT_FORCE_N
+        drive["force_n"] = default if args.force_n is None else args.force_n
+    if "ramp_s" in keys:
+        drive["ramp_s"] = (min(DEFAULT_RAMP_S, 0.5 * args.duration) if args.ramp_s is None
+                           else args.ramp_s)
+    return drive
 
 
 #: The run options behind the names of :func:`workbench.model.simulate.check_settings`.
@@ -231,6 +252,8 @@ RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--outp
 
 
 def _cmd_run(args) -> int:
+    from .experiments import files
+    from .experiments.matching import settings_of
     from .model import drives
     from .model.simulate import check_settings, simulate
     n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse,
@@ -241,24 +264,24 @@ def _cmd_run(args) -> int:
         raise ParameterError("--drive-set sets a --drive: give --drive KIND")
     p = _parameters(args)
     names = dict(RUN_OPTION_NAMES)
+    drive = _run_drive(args)
     if args.drive is not None:
-        settings = _drive_settings(args)
-        ex = drives.excitation_array(settings)
-        start = drives.start_keywords(settings)
-        names.update({key: f"--drive-set {key}" for key in settings if key != "kind"})
-    else:
-        if args.ramp_s is None and (args.freq_hz is not None or args.chirp is not None):
-            args.ramp_s = min(DEFAULT_RAMP_S, 0.5 * args.duration)
-        ex = _excitation(args)
-        start = {"free_decay_cm": args.free_decay}
-    check_settings(p, ex if ex is not None else _excitation_none(), args.duration,
-                   args.dt, args.output_hz, names=names)
+        names.update({key: f"--drive-set {key}" for key in drive if key != "kind"})
+    ex = drives.excitation_array(drive)
+    check_settings(p, ex, args.duration, args.dt, args.output_hz, names=names)
     if args.out:
-        check_output_file("--out", args.out, (".parquet",))
+        check_output_file("--out", args.out, files.SUFFIXES)
+        meta = settings_of(drive, p)
+        files.check_settings(args.out, meta)
     run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
-                   initial=args.initial, progress=not args.json and sys.stderr.isatty(), **start)
+                   initial=args.initial, progress=not args.json and sys.stderr.isatty(),
+                   **drives.start_keywords(drive))
     if args.out:
-        run.to_parquet(args.out)
+        if files.format_of(args.out) == "parquet":       # the whole run: every signal, events
+            run.signals.attrs["meta"] = meta
+            run.to_parquet(args.out)
+        else:
+            files.write(args.out, files.record_from_run(run), meta)
     summary = run.summary()
     if args.json:
         print(json_text(summary))
@@ -266,11 +289,6 @@ def _cmd_run(args) -> int:
         for key, value in summary.items():
             print(f"{key:>24}: {value}")
     return EXIT_OK if run.ok else EXIT_RUN_FAILED
-
-
-def _excitation_none():
-    from .model.excitation import none
-    return none()
 
 
 def _cmd_params(args) -> int:
@@ -403,18 +421,9 @@ def _record_settings(args, meta: dict) -> dict:
     if args.mu is not None:
         settings.update(mu_s=args.mu, mu_k=args.mu)
     settings.update({name: _value(text) for name, text in _pairs(args.set, "--set").items()})
-    drive = {}
-    if args.freq_hz is not None:
-        drive = {"drive": "sine", "freq_hz": args.freq_hz}
-    elif args.chirp is not None:
-        drive = dict(zip(("drive", "f0_hz", "f1_hz", "sweep_s"), ("chirp", *args.chirp)))
-    elif args.free_decay is not None:
-        drive = {"drive": "free_decay", "deflection_cm": args.free_decay}
-    elif args.impulse is not None:
-        drive = {"drive": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
-    elif args.drive is not None:
-        settings_of_drive = _drive_settings(args)
-        drive = {"drive": settings_of_drive.pop("kind"), **settings_of_drive}
+    drive = _shortcut_drive(args)
+    if drive:
+        drive = {"drive": drive.pop("kind"), **drive}
     if drive:                  # a drive given here replaces the file's (its amplitude may stay)
         for key in set(drives.all_keys()) - {"force_n", "ramp_s"} | {"drive"}:
             settings.pop(key, None)
@@ -439,10 +448,14 @@ def _pair_numbers(items, option, what, lo=None, lo_open=False) -> dict[str, floa
     return out
 
 
-def _read_record(args, path):
-    from .experiments.files import read
+def _strain_scale(args) -> dict[str, float]:
     scale = _pair_numbers(args.strain_scale, "--strain-scale", "STRAIN_PER_VOLT", 0, lo_open=True)
-    return read(path, strain_scale={name.lower(): value for name, value in scale.items()})
+    return {name.lower(): value for name, value in scale.items()}
+
+
+def _read_record(args, path):
+    from .experiments import files
+    return files.read(path, _strain_scale(args), files.format_of(path, args.format))
 
 
 def _add_joint_options(parser) -> None:
@@ -458,6 +471,13 @@ def _add_record_options(parser) -> None:
                         help="scale factor of a strain channel recorded in V (strain per volt)")
     parser.add_argument("--skip-s", type=_number(0), default=0.0,
                         help="leave out the first seconds (the transient)")
+    _add_format_option(parser)
+
+
+def _add_format_option(parser, option="--format", dest="format", what="the file's format") -> None:
+    from .experiments.files import FORMATS
+    parser.add_argument(option, dest=dest, choices=tuple(FORMATS),
+                        help=f"{what} (default: by its suffix)")
 
 
 def _check_window(path, record, skip_s: float) -> None:
@@ -466,6 +486,23 @@ def _check_window(path, record, skip_s: float) -> None:
     if len(t) < 2 or t[-1] - t[0] <= skip_s:
         raise ParameterError(f"--skip-s {skip_s:g}: {path} lasts {t[-1] - t[0]:g} s; leave "
                              "less out than that")
+
+
+def _cmd_convert(args) -> int:
+    from .experiments import files
+    source_format = files.format_of(args.source, args.source_format, option="--from")
+    target_format = files.format_of(args.target, args.target_format, option="--to")
+    check_output_file("TARGET", args.target)
+    if Path(args.target).resolve() == Path(args.source).resolve():
+        raise ParameterError(f"TARGET {args.target}: is the SOURCE; write to another file")
+    record = files.convert(args.source, args.target, _strain_scale(args), source_format,
+                           target_format)
+    t = record.index.to_numpy()
+    print(json_text({"source": args.source, "target": args.target, "format": target_format,
+                     "channels": list(record.columns), "samples": len(record),
+                     "duration_s": float(t[-1] - t[0]), "settings": record.attrs["meta"],
+                     "units_assumed": record.attrs["units_assumed"]}))
+    return EXIT_OK
 
 
 def _cmd_compare(args) -> int:
@@ -501,18 +538,13 @@ def _cmd_frf(args) -> int:
     from .experiments.frf import frf, peaks
     from .present.figures import frf_figure, save
 
+    from .experiments.formats import uff
+
     path = Path(args.file)
-    if path.suffix == ".parquet":
-        if not path.is_file():
-            raise ParameterError(f"{args.file}: no such file")
-        try:
-            record = pd.read_parquet(path)
-        except (OSError, ValueError) as exc:      # missing, unreadable, not Parquet
-            raise ParameterError(f"{args.file}: cannot be read as Parquet ({_one_line(exc)})") from None
-        if not pd.api.types.is_numeric_dtype(record.index) or len(record) < 2:
-            raise ParameterError(f"{args.file}: not a run's signals (indexed by time, s)")
-    else:
-        record = _read_record(args, args.file)
+    record = _read_record(args, args.file)
+    meta = record.attrs.get("meta", {})
+    uff.check_settings(Path(args.file), meta, records=len(args.response) or sum(
+        str(c).startswith(("accel", "strain")) for c in record.columns))
     _check_window(args.file, record, args.skip_s)
     t = record.index.to_numpy()
     length = (t[-1] - t[0] - args.skip_s) * len(t) / max(len(t) - 1, 1)    # samples x dt
@@ -540,7 +572,9 @@ def _cmd_frf(args) -> int:
                                   + "\n")
     figures = save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against "
                               f"{args.force}", args.f_max), out / "frf")
+    uff.write_frf(out / "frf.uff", table, responses, args.force, meta=meta)
     print(json_text({"record": args.file, "out": str(out), "resolution_hz": float(table.index[1]),
+                     "uff": str(out / "frf.uff"),
                      "figures": [str(p) for p in figures if p.suffix == ".png"],
                      "peaks": peak_table.to_dict("records")}))
     return 0
@@ -622,7 +656,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--output-hz", type=_number(0, MAX_OUTPUT_HZ, lo_open=True), default=1000.0, help="sample rate of the signals")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")
-    run.add_argument("--out", metavar="FILE.parquet", help="write the signals (and events) to Parquet")
+    run.add_argument("--out", metavar="FILE", help="write the signals, in the format of the suffix: "
+                     ".parquet (every signal, and the events), .lvm, .txt, .tdms, .uff (Table 2)")
     run.add_argument("--json", action="store_true", help="print one JSON object")
     run.set_defaults(func=_cmd_run)
 
@@ -654,7 +689,7 @@ def build_parser() -> argparse.ArgumentParser:
     compare.set_defaults(func=_cmd_compare)
 
     fr = sub.add_parser("frf", help="H1, H2 and coherence of a record or a run against its force")
-    fr.add_argument("file", help="a .lvm or tab-delimited record, or a run's .parquet (workbench run --out)")
+    fr.add_argument("file", help="a record (.lvm .txt .tdms .uff .parquet), e.g. of workbench run --out")
     fr.add_argument("--force", default="force1", help="the force channel (default force1)")
     fr.add_argument("--response", action="append", default=[],
                     help="a response channel, repeatable (default: every accel and strain)")
@@ -666,8 +701,18 @@ def build_parser() -> argparse.ArgumentParser:
                     help="highest frequency shown and searched for peaks (Hz)")
     fr.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
                     help="scale factor of a strain channel recorded in V (strain per volt)")
+    _add_format_option(fr)
     fr.add_argument("--out", help="output folder (default results/frf/<file stem>)")
     fr.set_defaults(func=_cmd_frf)
+
+    conv = sub.add_parser("convert", help="write a record in another format (.lvm .txt .tdms .uff .parquet)")
+    conv.add_argument("source", help="the record to read")
+    conv.add_argument("target", help="the file to write (its format by its suffix or --to)")
+    _add_format_option(conv, "--from", "source_format", "the source's format")
+    _add_format_option(conv, "--to", "target_format", "the target's format")
+    conv.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
+                      help="scale factor of a strain channel recorded in V (strain per volt)")
+    conv.set_defaults(func=_cmd_convert)
 
     est = sub.add_parser("estimate", help="fit model parameters to measurement files (§7.2)")
     est.add_argument("files", nargs="+", help="records (.lvm or tab-delimited)")

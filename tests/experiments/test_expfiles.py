@@ -45,15 +45,16 @@ def test_units_and_labels_of_a_hand_written_text_file(tmp_path):
 
 
 def test_lvm_without_x_column_uses_x0_and_delta_x(tmp_path):
-    text = F.write_lvm(tmp_path / "a.lvm", _record(5)).read_text()
-    lines = text.split("\n")
-    lines = [l.replace("X_Columns\tOne", "X_Columns\tNo") for l in lines]
-    lines = [l.replace("X_Value\t", "", 1) if l.startswith("X_Value") else l for l in lines]
-    body = lines.index(next(l for l in lines if l.startswith("Force1")))
-    lines[body + 1:] = ["\t".join(l.split("\t")[1:]) for l in lines[body + 1:]]
+    """X_Columns No (NI's LVM specification): the rows leave the X column empty and the
+    time is X0 + k Delta_X."""
+    text = F.write(tmp_path / "a.lvm", _record(5)).read_text()
+    lines = [l.replace("X_Columns\tOne", "X_Columns\tNo") for l in text.split("\n")]
+    body = next(i for i, l in enumerate(lines) if l.startswith("X_Value"))
+    lines[body + 1:] = ["\t" + l.split("\t", 1)[1] if l else l for l in lines[body + 1:]]
     (tmp_path / "b.lvm").write_text("\n".join(lines))
     rec = F.read(tmp_path / "b.lvm")
     np.testing.assert_allclose(rec.index.to_numpy(), np.arange(5) * 1e-3)
+    np.testing.assert_allclose(rec.to_numpy(), _record(5).to_numpy(), rtol=1e-9, atol=1e-20)
 
 
 @pytest.mark.parametrize("edit, line, problem", [
@@ -73,7 +74,7 @@ def test_lvm_without_x_column_uses_x0_and_delta_x(tmp_path):
      "does not increase"),
 ])
 def test_damaged_lvm_names_file_line_and_problem(tmp_path, edit, line, problem):
-    lines = F.write_lvm(tmp_path / "good.lvm", _record(), {"gap_mm": 1.016}).read_text().split("\n")
+    lines = F.write(tmp_path / "good.lvm", _record(), {"gap_mm": 1.016}).read_text().split("\n")
     bad = tmp_path / "bad.lvm"
     bad.write_text("\n".join(edit(lines)))
     with pytest.raises(F.ExperimentFileError) as err:

@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .files import CHANNELS, kind, record_from_run
+from .channels import CHANNELS, kind
+from .files import record_from_run
 from ..identify.contacts import PATCHES, contact_code_series
 from ..study.metrics import CONTACT_CODES, psd, spectral_peaks
 

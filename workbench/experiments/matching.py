@@ -36,10 +36,13 @@ class Setup:
         return simulate(params or self.params, drives.excitation_array(exc), self.duration,
                         output_hz=self.output_hz, **drives.start_keywords(exc))
 
-    def meta(self, model_keys: dict) -> dict:
-        """The ``WB_`` settings to write with a simulated record of this setup."""
-        exc = dict(self.excitation)
-        return {"drive": exc.pop("kind"), **exc, **model_keys}
+
+def settings_of(excitation: dict, params: Parameters) -> dict:
+    """The settings to write with a simulated record (``WB_`` keys), which
+    :func:`setup_from` reads back: the drive, its settings, and the model parameters
+    that differ from the defaults (CGS names)."""
+    exc = dict(excitation)
+    return {"drive": exc.pop("kind"), **exc, **params.changed()}
 
 
 def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = None) -> Setup:

@@ -258,6 +258,11 @@ class Parameters:
         except ParameterError as exc:
             raise ParameterError(f"{path}: {exc}") from None
 
+    def changed(self) -> dict[str, Any]:
+        """The parameters that differ from their defaults (CGS names and units)."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
+                if getattr(self, f.name) != f.default}
+
     def to_dict(self) -> dict[str, Any]:
         """All parameters as a plain dict (CGS), for provenance records."""
         return dataclasses.asdict(self)
