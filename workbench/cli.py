@@ -523,7 +523,8 @@ def _cmd_compare(args) -> int:
     run = setup.simulate()
     title = f"{Path(args.file).name} vs simulation ({setup.excitation['kind']})"
     result = compare(record, run, out, skip_s=args.skip_s, threshold=args.threshold,
-                     chirp=drives.DRIVES[setup.excitation["kind"]].swept, title=title)
+                     chirp=drives.DRIVES[setup.excitation["kind"]].swept,
+                     band=drives.band_hz(setup.excitation), title=title)
     print(json_text({"record": args.file, "simulation_status": run.status, "out": str(out),
                       "figures": [str(p) for p in result.figures if p.suffix == ".png"],
                       "rms_error_rel": dict(zip(result.signals.channel,
@@ -532,13 +533,9 @@ def _cmd_compare(args) -> int:
 
 
 def _cmd_frf(args) -> int:
-    import numpy as np
-    import pandas as pd
-
-    from .experiments.frf import frf, peaks
-    from .present.figures import frf_figure, save
-
     from .experiments.formats import uff
+    from .experiments.frf import frf, magnitude_phase, peak_table as peak_table_of, responses_of
+    from .present.figures import frf_figure, save
 
     path = Path(args.file)
     record = _read_record(args, args.file)
@@ -555,17 +552,10 @@ def _cmd_frf(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     table = frf(record, args.response or None, force=args.force, segment_s=args.segment_s,
                 skip_s=args.skip_s)
-    responses = sorted({c.rsplit("_", 1)[0] for c in table.columns})
-    flat = pd.DataFrame(index=table.index)
-    for r in responses:
-        for est in ("H1", "H2"):
-            flat[f"{r}_{est}_abs"] = table[f"{r}_{est}"].abs()
-            flat[f"{r}_{est}_phase_deg"] = np.degrees(np.angle(table[f"{r}_{est}"]))
-        flat[f"{r}_coherence"] = table[f"{r}_coherence"]
-    flat.to_csv(out / "frf.csv")
-    rows = [peaks(table, r, args.f_min, args.f_max).assign(response=r) for r in responses]
-    peak_table = pd.concat(rows, ignore_index=True)[["response", "f_hz", "magnitude", "coherence",
-                                                      "zeta_half_power"]]
+    responses = responses_of(table)
+    magnitude_phase(table).to_csv(out / "frf.csv")
+    peak_table = peak_table_of({args.file: table}, responses, args.f_min,
+                               args.f_max).drop(columns="source")
     peak_table.to_csv(out / "peaks.csv", index=False)
     (out / "peaks.md").write_text("# FRF peaks (H1): frequency, magnitude, coherence, half-power "
                                   "damping ratio\n\n" + peak_table.to_markdown(index=False, floatfmt=".4g")

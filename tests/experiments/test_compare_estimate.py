@@ -97,14 +97,19 @@ def test_matching_setup_refuses_bad_settings():
         setup_from({"gap_mm": 9.0}, base)
 
 
-def test_compare_of_a_chirp_draws_both_spectrograms(tmp_path):
+def test_compare_of_a_chirp_draws_both_spectrograms_and_the_frfs(tmp_path):
     settings = {"drive": "chirp", "f0_hz": 5.0, "f1_hz": 65.0, "sweep_s": 2.0, "ramp_s": 0.2}
     setup = setup_from(settings, _time_base(2.0))
     run = setup.simulate()
     path = F.write(tmp_path / "chirp.txt", F.record_from_run(run), settings)
     out = tmp_path / "cmp"
     assert main(["compare", str(path), "--out", str(out)]) == 0
-    for name in ("spectrogram_record", "spectrogram_simulation", "switching"):
+    for name in ("spectrogram_record", "spectrogram_simulation", "switching", "frf"):
         assert (out / f"{name}.png").exists()
     signals = pd.read_csv(out / "differences_signals.csv")
     assert signals.rms_error_rel.max() < 1e-6      # the same model, no noise
+    peaks = pd.read_csv(out / "differences_frf_peaks.csv")
+    assert set(peaks.source) == {"record", "simulation"} and peaks.f_hz.between(5, 65).all()
+    by_source = [peaks[peaks.source == s].drop(columns="source").reset_index(drop=True)
+                 for s in ("record", "simulation")]
+    pd.testing.assert_frame_equal(*by_source, rtol=1e-5)    # the same model: the same peaks

@@ -248,7 +248,7 @@ def test_report_figures_and_tables_of_a_grid(small_run):
     assert all(len(s) == round(0.2 * f) + 1 for s, f in zip(table.tip_poincare, table.axis_freq_hz))
 
 
-def test_report_of_a_chirp_has_a_spectrogram(tmp_path):
+def test_report_of_a_chirp_has_a_spectrogram_and_its_frfs(tmp_path):
     text = """
 [study]
 name = "chirp"
@@ -274,6 +274,11 @@ gap_mm = [1.016]
     assert not (out / "figures" / "frf_map_tip.png").exists()     # no gap x frequency grid
     long = pd.read_csv(out / "tables" / "response.csv")
     assert long.tip_rms.iloc[0] == pytest.approx(table.tip_rms.iloc[0], rel=1e-12)
+    assert (out / "figures" / f"frf_{table.key.iloc[0][:8]}.png").exists()
+    peaks = pd.read_csv(out / "tables" / "frf_peaks.csv")
+    assert set(peaks.response) <= {"strain1", "accel1", "accel2", "strain2", "accel3"}
+    assert len(peaks) > 0 and peaks.f_hz.between(5.0, 65.0).all()       # the chirp's band
+    assert "frf_peaks.md" in (out / "report.md").read_text()
 
 
 def test_a_damaged_point_file_is_set_aside_and_recomputed(small_run, tmp_path, capsys):

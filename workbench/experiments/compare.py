@@ -7,7 +7,11 @@ The four comparisons of the paper, as figures, and a table of differences:
 3. contact switching diagrams (Fig. 9-10), both sides through the same
    detection (:func:`workbench.identify.contact_code_series`; a simulated
    patch reads 1 V while its point is closed);
-4. for chirps, spectrograms of strain1 (Fig. 11-12).
+4. for chirps, spectrograms of strain1 (Fig. 11-12);
+5. for chirps, the FRFs (H1 and coherence of each acceleration and strain
+   against force1, :mod:`workbench.experiments.frf`), simulation over
+   record, with the peaks of each in the chirp's band (a sine's force has
+   no band to refer a response to).
 
 The differences (``differences.csv``/``.md``), over the comparison window:
 
@@ -17,11 +21,13 @@ The differences (``differences.csv``/``.md``), over the comparison window:
 * per channel, the three most prominent spectral peaks of the record and
   the nearest peak of the simulation: their frequencies and shift (Hz);
 * per contact code, the share of time in the record and in the simulation
-  and their difference.
+  and their difference;
+* for chirps, the FRF peaks of record and simulation: frequency, |H1|, coherence and
+  half-power damping ratio.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +35,8 @@ import pandas as pd
 
 from .channels import CHANNELS, kind
 from .files import record_from_run
+from .frf import frf, peak_table, segment_for
+from ..model.params import ParameterError
 from ..identify.contacts import PATCHES, contact_code_series
 from ..study.metrics import CONTACT_CODES, psd, spectral_peaks
 
@@ -46,6 +54,8 @@ class Comparison:
     peaks: pd.DataFrame         # channel, rank -> record / simulation peak, shift
     contacts: pd.DataFrame      # code -> shares, difference
     figures: list
+    frf_peaks: pd.DataFrame | None = None     # source, response -> FRF peaks
+    notes: list = field(default_factory=list)
 
 
 def window(record: pd.DataFrame, skip_s: float) -> pd.DataFrame:
@@ -109,8 +119,9 @@ def contact_differences(rec_codes: pd.Series, sim_codes: pd.Series) -> pd.DataFr
 
 def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
             threshold=DEFAULT_THRESHOLD_V, seconds: float = 0.5, chirp: bool = False,
-            title: str = "") -> Comparison:
-    """Compare ``record`` with a simulated ``run`` and write figures and tables into ``out``."""
+            band: tuple[float, float] | None = None, title: str = "") -> Comparison:
+    """Compare ``record`` with a simulated ``run`` and write figures and tables into ``out``;
+    ``band`` (Hz) limits the FRF peaks to where the drive has force (a chirp's band)."""
     from ..present import figures as F
 
     out = Path(out)
@@ -134,13 +145,27 @@ def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
         for name, rec in sources.items():
             result.figures += F.save(F.spectrogram(rec, f"{title} — {name}"),
                                      out / f"spectrogram_{name}")
+    responses = [c for c in channels if kind(c) in ("accel", "strain")]
+    if chirp and "force1" in rec_w.columns and responses:
+        try:
+            seg = segment_for(rec_w)
+            tables = {name: frf(rec, responses, segment_s=seg) for name, rec in sources.items()}
+        except ParameterError as exc:
+            result.notes.append(f"FRFs not computed: {exc}")
+        else:
+            f_lo, f_hi = band or (0.0, None)
+            result.frf_peaks = peak_table(tables, responses, f_lo, f_hi)
+            result.figures += F.save(F.frf_figure(tables, responses, f"{title}: H1 against force1",
+                                                  1.2 * f_hi if f_hi else None), out / "frf")
     _write_tables(result, out, title)
     return result
 
 
 def _write_tables(result: Comparison, out: Path, title: str) -> None:
     tables = {"signals": result.signals, "peaks": result.peaks, "contacts": result.contacts}
-    md = [f"# Comparison: {title}", ""]
+    if result.frf_peaks is not None:
+        tables["frf_peaks"] = result.frf_peaks
+    md = [f"# Comparison: {title}", ""] + [f"{note}\n" for note in result.notes]
     for name, table in tables.items():
         table.to_csv(out / f"differences_{name}.csv", index=False)
         md += [f"## {name}", "", table.to_markdown(index=False, floatfmt=".4g") if len(table)

@@ -123,3 +123,37 @@ def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: flo
         rows.append({"f_hz": float(fb[i]), "magnitude": float(mag[i]),
                      "coherence": float(coh[i]), "zeta_half_power": float(zeta)})
     return pd.DataFrame(rows, columns=["f_hz", "magnitude", "coherence", "zeta_half_power"])
+
+
+def peak_table(tables: dict[str, pd.DataFrame], responses, f_min: float = 0.0,
+               f_max: float | None = None) -> pd.DataFrame:
+    """The H1 peaks of each response of each FRF table ({source: table}), one row per
+    peak: source, response, f_hz, magnitude, coherence, zeta_half_power."""
+    rows = [peaks(table, r, f_min, f_max).assign(source=source, response=r)
+            for source, table in tables.items() for r in responses]
+    columns = ["source", "response", "f_hz", "magnitude", "coherence", "zeta_half_power"]
+    rows = [r for r in rows if len(r)]
+    return pd.concat(rows, ignore_index=True)[columns] if rows else pd.DataFrame(columns=columns)
+
+
+def segment_for(record: pd.DataFrame, segment_s: float = DEFAULT_SEGMENT_S,
+                n_segments: int = 4) -> float:
+    """``segment_s``, shortened so that the record holds at least ``n_segments`` (s)."""
+    t = record.index.to_numpy(dtype=float)
+    return min(segment_s, (t[-1] - t[0]) / n_segments)
+
+
+def responses_of(table: pd.DataFrame) -> list[str]:
+    """The response channels of an FRF table."""
+    return sorted({c.rsplit("_", 1)[0] for c in table.columns})
+
+
+def magnitude_phase(table: pd.DataFrame) -> pd.DataFrame:
+    """An FRF table in real columns: |H1|, |H2|, their phases (deg) and the coherence."""
+    flat = pd.DataFrame(index=table.index)
+    for r in responses_of(table):
+        for est in ("H1", "H2"):
+            flat[f"{r}_{est}_abs"] = table[f"{r}_{est}"].abs()
+            flat[f"{r}_{est}_phase_deg"] = np.degrees(np.angle(table[f"{r}_{est}"]))
+        flat[f"{r}_coherence"] = table[f"{r}_coherence"]
+    return flat

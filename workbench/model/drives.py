@@ -82,6 +82,13 @@ def start_keywords(settings: dict) -> dict:
     return get(settings["kind"]).start(settings)
 
 
+def band_hz(settings: dict) -> tuple[float, float] | None:
+    """The frequency band (Hz) a swept drive covers, else None."""
+    if not get(settings["kind"]).swept:
+        return None
+    return tuple(sorted((settings["f0_hz"], settings["f1_hz"])))
+
+
 def drive_hz(settings: dict) -> float | None:
     """The forcing frequency (Hz) of a drive that has one, else None."""
     key = get(settings["kind"]).frequency_key

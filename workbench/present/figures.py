@@ -296,23 +296,32 @@ def code_series_diagrams(codes: dict[str, pd.Series], title: str, seconds: float
     return fig
 
 
-def frf_figure(table: pd.DataFrame, responses, title: str, f_max: float | None = None):
-    """|H1| and |H2|, the phase of H1 and the coherence of each response (one column each)."""
-    f = table.index.to_numpy()
-    band = (f > 0) & (f <= (f_max if f_max is not None else f[-1]))
+def frf_figure(tables, responses, title: str, f_max: float | None = None):
+    """|H|, the phase of H1 and the coherence of each response (one column each).
+
+    ``tables``: one FRF table (:func:`workbench.experiments.frf.frf`), drawn as H1 and
+    H2; or {source: table} (simulation over experiment), drawn as each source's H1."""
+    sources = {"": tables} if isinstance(tables, pd.DataFrame) else dict(tables)
+    single = len(sources) == 1
     fig, axes = plt.subplots(3, len(responses), figsize=(4.2 * len(responses), 7.5), sharex=True,
                              squeeze=False, gridspec_kw={"height_ratios": [2, 1, 1]})
     for j, r in enumerate(responses):
-        h1, h2 = table[f"{r}_H1"].to_numpy()[band], table[f"{r}_H2"].to_numpy()[band]
-        ax = axes[0, j]
-        ax.semilogy(f[band], np.abs(h1), label="H1")
-        ax.semilogy(f[band], np.abs(h2), label="H2", alpha=0.7)
-        ax.set_title(r, fontsize=9)
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3, which="both")
-        axes[1, j].plot(f[band], np.degrees(np.angle(h1)), lw=0.8)
+        for source, table in sources.items():
+            f = table.index.to_numpy()
+            band = (f > 0) & (f <= (f_max if f_max is not None else f[-1]))
+            h1 = table[f"{r}_H1"].to_numpy()[band]
+            name = f"{source} H1".strip()
+            axes[0, j].semilogy(f[band], np.abs(h1), label=name, lw=0.9)
+            if single:
+                axes[0, j].semilogy(f[band], np.abs(table[f"{r}_H2"].to_numpy()[band]),
+                                    label="H2", alpha=0.7, lw=0.9)
+            axes[1, j].plot(f[band], np.degrees(np.angle(h1)), lw=0.8, label=name)
+            axes[2, j].plot(f[band], table[f"{r}_coherence"].to_numpy()[band], lw=0.8,
+                            label=source or None)
+        axes[0, j].set_title(r, fontsize=9)
+        axes[0, j].legend(fontsize=8)
+        axes[0, j].grid(alpha=0.3, which="both")
         axes[1, j].set_ylabel("phase H1 (deg)")
-        axes[2, j].plot(f[band], table[f"{r}_coherence"].to_numpy()[band], lw=0.8)
         axes[2, j].set_ylim(0, 1.05)
         axes[2, j].set_ylabel("coherence")
         axes[2, j].set_xlabel("frequency (Hz)")

@@ -10,7 +10,9 @@ Which figures a study gets depends on its axes: the maps and curves need
 gap_mm and freq_hz axes, the shares and the bifurcation diagram need a
 sine drive over several frequencies; every point with a saved time series
 gets a time history, strain spectra and a switching diagram, and a chirp a
-spectrogram as well.
+spectrogram and its FRFs (H1 and coherence of every acceleration and strain
+against force1, :mod:`workbench.experiments.frf`) as well, with their peaks
+in ``tables/frf_peaks.{csv,md}``.
 """
 from __future__ import annotations
 
@@ -27,7 +29,12 @@ from ..study.provenance import environment
 from ..study.store import read_runs, write_text_atomic
 from ..model import drives
 from ..study.definition import Study
-from .tables import write_tables
+from .tables import write_frf_peaks, write_tables
+from ..experiments.channels import CHANNELS, kind
+from ..experiments.frf import frf, peak_table, segment_for
+
+#: The channels whose FRF against force1 a chirp's report shows.
+RESPONSES = tuple(c for c in CHANNELS if kind(c) in ("accel", "strain"))
 
 
 def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
@@ -47,8 +54,9 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     return figs
 
 
-def _series_figures(study: Study, table: pd.DataFrame, out: Path):
-    """(name, figure builder) per saved series, one point's series in memory at a time."""
+def _series_figures(study: Study, table: pd.DataFrame, out: Path, frf_peaks: list):
+    """(name, figure builder) per saved series, one point's series in memory at a time;
+    the FRF peaks of a chirp's series are added to ``frf_peaks``."""
     for _, row in table.iterrows():
         path = out / "series" / f"{row.key}.parquet"
         if not path.exists():
@@ -68,6 +76,13 @@ def _series_figures(study: Study, table: pd.DataFrame, out: Path):
         yield f"switching_{tag}", lambda: F.switching_diagram(ev, t_end, title, short)
         if drives.DRIVES[study.excitation["kind"]].swept:
             yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
+            responses = [c for c in sig.columns if c in RESPONSES]
+            f_lo, f_hi = drives.band_hz(study.excitation)
+            tables = {title: frf(sig, responses, segment_s=segment_for(sig))}
+            frf_peaks.append(peak_table(tables, responses, f_lo, f_hi))
+            yield f"frf_{tag}", lambda: F.frf_figure(tables[title], responses,
+                                                     f"{title}: H1, H2, coherence against force1",
+                                                     f_max=1.2 * f_hi)
 
 
 def make_report(study: Study, results: str | Path = "results") -> Path:
@@ -75,12 +90,14 @@ def make_report(study: Study, results: str | Path = "results") -> Path:
     out = Path(results) / study.name
     table = pd.read_parquet(out / "points.parquet")
     t0 = time.perf_counter()
-    made = {}
+    made, frf_peaks = {}, []
     builders = itertools.chain(_grid_figures(study, table).items(),
-                               _series_figures(study, table, out))
+                               _series_figures(study, table, out, frf_peaks))
     for name, build in builders:
         made[name] = F.save(build(), out / "figures" / name)
     tables = write_tables(table, out / "tables")
+    if frf_peaks:
+        tables += write_frf_peaks(pd.concat(frf_peaks, ignore_index=True), out / "tables")
     report_wall = time.perf_counter() - t0
     provenance = {**environment(), "study": study_definition(study),
                   "points": summary(table), "report_wall_s": report_wall,

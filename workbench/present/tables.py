@@ -12,7 +12,8 @@ The CSV is long (one row per point, every column, ``steady`` and
 ``status`` included).  The Markdown and LaTeX tables pivot one quantity per
 block: gap rows, frequency columns; ``*`` marks a point that is not steady
 and ``failed`` one that did not finish.  A study without both axes gets
-the long table in every format.
+the long table in every format.  A study of chirps also gets ``frf_peaks``,
+the peaks of each point's FRFs (:func:`write_frf_peaks`).
 """
 from __future__ import annotations
 
@@ -105,3 +106,16 @@ def write_tables(table: pd.DataFrame, out: Path) -> list[Path]:
         (out / f"{name}.tex").write_text("\n".join(tex).replace("²", "$^2$"))
         written += [csv, out / f"{name}.md", out / f"{name}.tex"]
     return written
+
+
+def write_frf_peaks(peaks: pd.DataFrame, out: Path) -> list[Path]:
+    """The FRF peaks of a study's chirps (``frf_peaks.{csv,md,tex}``); return the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    peaks = peaks.rename(columns={"source": "point"})
+    caption = "FRF peaks (H1 against force1): frequency (Hz), |H1|, coherence, half-power damping ratio"
+    paths = [out / f"frf_peaks.{ext}" for ext in ("csv", "md", "tex")]
+    peaks.to_csv(paths[0], index=False)
+    paths[1].write_text(f"# {caption}\n\n{peaks.to_markdown(index=False, floatfmt='.4g')}\n")
+    paths[2].write_text(peaks.to_latex(index=False, float_format="%.4g", escape=True,
+                                       caption=latex_text(caption)))
+    return paths
