@@ -151,7 +151,7 @@ def files(tmp_path):
     (tmp_path / "afile").write_text("x")
     return {"S": _study(tmp_path, GOOD_STUDY), "R": tmp_path / "r.lvm",
             "F": tmp_path / "afile", "NOSIG": tmp_path / "nosig.lvm",
-            "BADWB": tmp_path / "badwb.lvm"}
+            "BADWB": tmp_path / "badwb.lvm", "OUT": tmp_path / "converted.tdms"}
 
 
 def _fill(argv, files):
@@ -321,11 +321,11 @@ def test_fuzzed_experiment_files_never_crash(cut, junk, files, capsys):
 
 COMMANDS = [["sweep", "S", "--dry-run"], ["compare", "R"], ["estimate", "R", "--fit", "e_b=6e11"],
             ["modes"], ["params"], ["identify", "decrement", "1", "0.5", "0", "1", "5"],
-            ["identify", "tables", "--no-table6"], ["frf", "R"]]
+            ["identify", "tables", "--no-table6"], ["frf", "R"], ["convert", "R", "OUT"]]
 MORE_OPTIONS = OPTIONS + ["--jobs", "--scheduler", "--results", "--fresh", "--skip-s",
                           "--strain-scale", "--threshold", "--fit", "--max-nfev", "--beam",
                           "--joint", "--params", "--json", "--force", "--response", "--segment-s",
-                          "--f-min", "--f-max"]
+                          "--f-min", "--f-max", "--format", "--from", "--to"]
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=list(HealthCheck))
