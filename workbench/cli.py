@@ -397,18 +397,10 @@ def _drive_settings(args) -> dict:
     if unknown:
         raise ParameterError(f"--drive-set {_cut(unknown[0])}: not a setting of --drive "
                              f"{drive.kind} (its settings: {', '.join(drive.keys) or 'none'})")
-    settings = {"kind": drive.kind}
-    for key in drive.keys:
-        if key in given:
-            settings[key] = given[key]
-        elif key == "ramp_s" and drive.ramped and hasattr(args, "duration"):
-            settings[key] = min(DEFAULT_RAMP_S, 0.5 * args.duration)
-        elif key in drives.DEFAULTS:
-            settings[key] = drives.DEFAULTS[key]
-        else:
-            raise ParameterError(f"--drive {drive.kind} needs --drive-set {key}=VALUE "
-                                 f"({drives.UNITS[key]})")
-    return settings
+    if drive.ramped and "ramp_s" not in given and hasattr(args, "duration"):
+        given["ramp_s"] = min(DEFAULT_RAMP_S, 0.5 * args.duration)
+    return drives.complete(drive.kind, given, lambda key: f"--drive {drive.kind} needs "
+                           f"--drive-set {key}=VALUE ({drives.UNITS[key]})")
 
 
 def _record_settings(args, meta: dict) -> dict:

@@ -49,21 +49,17 @@ def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = N
     """The Setup of ``record`` from its settings (module docstring)."""
     settings = dict(settings)
     kind = settings.pop("drive", "none")
-    drive = drives.get(kind, where="drive")
-    exc = {"kind": kind}
-    for key in drive.keys:
+    given = {}
+    for key in drives.get(kind, where="drive").keys:
         if key in settings:
             value = settings.pop(key)
             try:
-                exc[key] = float(value)
+                given[key] = float(value)
             except (TypeError, ValueError, OverflowError):
                 raise ParameterError(f"{key} = {value!r} is not a number (WB_{key} in the file, "
                                      "or its option)") from None
-        elif key in drives.DEFAULTS:
-            exc[key] = drives.DEFAULTS[key]
-        else:
-            raise ParameterError(f"a {kind} drive needs {key} (in the file as WB_{key}, or "
-                                 "on the command line)")
+    exc = drives.complete(kind, given, lambda key: f"a {kind} drive needs {key} (in the file as "
+                          f"WB_{key}, or on the command line)", where="drive")
     for key in [k for k in settings if k in drives.all_keys()]:
         raise ParameterError(f"{key} does not apply to a {kind} drive")
     for key in settings:

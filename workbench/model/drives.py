@@ -62,6 +62,22 @@ def get(kind: str, where: str = "kind") -> Drive:
     return DRIVES[kind]
 
 
+def complete(kind: str, given: dict, needs: Callable[[str], str], where: str = "kind") -> dict:
+    """The settings {"kind": kind, key: value} of a drive: each key's value given, else its
+    default; a key with neither raises a ParameterError saying ``needs(key)`` (how to give
+    it, in the caller's words)."""
+    drive = get(kind, where)
+    settings = {"kind": drive.kind}
+    for key in drive.keys:
+        if key in given:
+            settings[key] = given[key]
+        elif key in DEFAULTS:
+            settings[key] = DEFAULTS[key]
+        else:
+            raise ParameterError(needs(key))
+    return settings
+
+
 def all_keys() -> list[str]:
     """Every setting of every drive."""
     return sorted({k for d in DRIVES.values() for k in d.keys})
