@@ -42,7 +42,11 @@ def cases() -> dict:
     return {"sine tip": (base.replace(tip_mass=True), sine(20.0, 20.0, ramp_s=1.0), 10.0, 5.0),
             "sine no tip": (base.replace(tip_mass=False), sine(20.0, 20.0, ramp_s=1.0), 10.0, 5.0),
             "chirp tip": (base.replace(tip_mass=True), chirp(10.0, 5.0, 65.0, 240.0, ramp_s=1.0),
-                          240.0, 120.0)}
+                          240.0, 120.0),
+            # the default 200 N: the loose body rocks (docs/verification.md)
+            "sine tip 200 N": (base.replace(tip_mass=True), sine(200.0, 20.0, ramp_s=1.0), 10.0, 5.0),
+            "sine no tip 200 N": (base.replace(tip_mass=False), sine(200.0, 20.0, ramp_s=1.0), 10.0,
+                                  5.0)}
 
 
 COLUMNS = ["w_A", "phi_A", "u_A", "s", "v", "psi", "w_B", "phi_B", "u_B"]

@@ -305,7 +305,7 @@ def test_rk4_stability_boundaries_closed_form():
     assert rk4_amplification(-2.79) > 1.0 > rk4_amplification(-2.78)
 
 
-@pytest.mark.parametrize("tip, expected", [(True, 1e-4), (False, 5e-5)])
+@pytest.mark.parametrize("tip, expected", [(True, 1e-4), (False, 6.25e-5)])
 def test_default_step_is_the_largest_stable_nice_step(tip, expected):
     p = Parameters(tip_mass=tip)
     dt = default_dt(p)

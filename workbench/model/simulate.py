@@ -31,8 +31,9 @@ from .regimes import contact_code, in_contact, is_stick, set_of
 from .statics import static_equilibrium, tip_load_for_deflection
 
 DEFAULT_OUTPUT_HZ = 1000.0
-#: Steps :func:`default_dt` chooses from (s): each divides 1 ms.
-NICE_STEPS = (1e-4, 5e-5, 4e-5, 2.5e-5, 2e-5, 1e-5, 5e-6)
+#: Steps :func:`default_dt` chooses from (s): 1 ms / n for n = 10 ... 200, so that each
+#: divides 1 ms (every output rate that divides 1 kHz, and every whole number of ms).
+NICE_STEPS = tuple(1e-3 / n for n in range(10, 201))
 #: :func:`default_dt` asks RK4 to be stable for every eigenvalue of the
 #: linear model scaled by this factor: room for the stiffening of contact.
 STABILITY_MARGIN = 1.25
@@ -55,10 +56,10 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
 
     Stable: |R(STABILITY_MARGIN lambda dt)| <= 1 for every eigenvalue lambda
     of :func:`workbench.model.modes.linear_eigenvalues`.  With the tip mass this
-    is 1e-4 s (the fastest mode, -246 +- 2.05e4 j 1/s); without it 5e-5 s
-    (-321 +- 3.54e4 j 1/s): the beams' lightly damped axial modes, near the
-    imaginary axis where RK4 is stable to |lambda dt| = 2.83.  A hammer
-    pulse gets at least PULSE_STEPS steps.
+    is 1e-4 s (MAX_DEFAULT_DT; the fastest mode is -246 +- 2.05e4 j 1/s); without
+    it 6.25e-5 s (1 ms / 16; -321 +- 3.54e4 j 1/s): the beams' lightly damped axial
+    modes, near the imaginary axis where RK4 is stable to |lambda dt| = 2.83.  A
+    hammer pulse gets at least PULSE_STEPS steps.
     """
     lam = STABILITY_MARGIN * _eigenvalues(p)
     limit = MAX_DEFAULT_DT
