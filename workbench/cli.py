@@ -228,6 +228,10 @@ def _run_drive(args) -> dict:
     from .model import drives, excitation as X
     drive = _shortcut_drive(args) or {"kind": "none"}
     if args.drive is not None:
+        for option, value in (("--force-n", args.force_n), ("--ramp-s", args.ramp_s)):
+            if value is not None:
+                raise ParameterError(f"{option} {value:g}: with --drive, give --drive-set "
+                                     f"{option[2:].replace('-', '_')}=VALUE")
         return drive
     hammer = args.impulse is not None
     if args.force_n is not None and args.force_n < 0 and not hammer:

@@ -120,7 +120,9 @@ def test_the_command_line_runs_a_registered_drive(sine_rms, capsys):
                        (["run", "--drive", "sine_rms", "--drive-set", "volts=3"],
                         "--drive-set volts: not a setting of --drive sine_rms"),
                        (["run", "--drive", "sine_rms"], "needs --drive-set freq_hz=VALUE (Hz)"),
-                       (["run", "--drive-set", "freq_hz=3"], "give --drive KIND")):
+                       (["run", "--drive-set", "freq_hz=3"], "give --drive KIND"),
+                       (["run", "--drive", "sine_rms", "--drive-set", "freq_hz=20", "--force-n", "3"],
+                        "--force-n 3: with --drive, give --drive-set force_n=VALUE")):
         assert cli.main(bad) == cli.EXIT_BAD_INPUT
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1 and words in err, err
