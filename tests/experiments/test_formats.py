@@ -157,6 +157,24 @@ def test_a_tdms_file_it_cannot_use_is_refused_clearly(tmp_path, objects, problem
     assert err.value.path == str(path)
 
 
+def test_a_truncated_tdms_file_is_refused_not_read_short(simulated, tmp_path, capsys):
+    """npTDMS reads on past a truncated segment with a warning: the reader refuses it,
+    and the warning is not printed."""
+    rec, meta = simulated
+    data = F.write(tmp_path / "run.tdms", rec, meta).read_bytes()
+    (tmp_path / "cut.tdms").write_bytes(data[:-1000])
+    with pytest.raises(F.ExperimentFileError, match="damaged or truncated TDMS file"):
+        F.read(tmp_path / "cut.tdms")
+    assert "nptdms" not in capsys.readouterr().err
+
+
+def test_values_out_of_range_in_cgs_are_refused(tmp_path):
+    path = tmp_path / "huge.txt"
+    path.write_text("Time\tForce1 (kN)\n0\t1e300\n0.001\t2e300\n")
+    with pytest.raises(F.ExperimentFileError, match="Force1: values that are not finite, or out of range"):
+        F.read(path)
+
+
 def test_a_uff_file_without_time_histories_or_with_ragged_ones_is_refused(simulated, tmp_path):
     rec, meta = simulated
     uff.write_frf(tmp_path / "frf_only.uff", pd.DataFrame(

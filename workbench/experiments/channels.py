@@ -149,8 +149,13 @@ def record(path, t: np.ndarray, data: np.ndarray, channels: list[str], factors: 
         line = line_of_row(int(bad[0]) + 1) if line_of_row else None
         raise ExperimentFileError(path, line, f"time {t[bad[0] + 1]} s does not increase "
                                   f"(previous {t[bad[0]]} s)")
-    df = pd.DataFrame(np.asarray(data, dtype=float) * np.asarray(factors), columns=channels,
-                      index=pd.Index(np.asarray(t, dtype=float), name="t"))
+    with np.errstate(over="ignore", invalid="ignore"):
+        values = np.asarray(data, dtype=float) * np.asarray(factors)
+    bad = np.flatnonzero(~np.all(np.isfinite(values), axis=0))
+    if len(bad):
+        raise ExperimentFileError(path, None, f"{TABLE2_NAMES[channels[bad[0]]]}: values that are "
+                                  "not finite, or out of range in CGS units")
+    df = pd.DataFrame(values, columns=channels, index=pd.Index(np.asarray(t, dtype=float), name="t"))
     df.attrs.update(meta=meta, units_assumed=assumed, source=str(path))
     return df
 

@@ -11,6 +11,8 @@ Table 2 channels.
 """
 from __future__ import annotations
 
+import contextlib
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -30,12 +32,16 @@ def read(path, strain_scale: dict | None = None):
     path = Path(path)
     if not path.is_file():
         raise ExperimentFileError(path, None, "no such file")
-    try:
-        tdms = TdmsFile.read(path)
-        groups = [(g, g.channels()) for g in tdms.groups()]
-    except Exception as exc:                  # noqa: BLE001 - npTDMS's word on a bad file
-        raise ExperimentFileError(path, None, f"not a readable TDMS file ({type(exc).__name__}: "
-                                  f"{' '.join(str(exc).split())[:120]})") from None
+    with _warnings_of("nptdms") as warned:
+        try:
+            tdms = TdmsFile.read(path)
+            groups = [(g, g.channels()) for g in tdms.groups()]
+        except Exception as exc:              # noqa: BLE001 - npTDMS's word on a bad file
+            raise ExperimentFileError(path, None, f"not a readable TDMS file ({type(exc).__name__}: "
+                                      f"{' '.join(str(exc).split())[:120]})") from None
+    if warned:                                # npTDMS reads on past damage, with a warning
+        raise ExperimentFileError(path, None, f"damaged or truncated TDMS file (npTDMS: "
+                                  f"{' '.join(warned[0].split())[:120]})")
     ours = [(g, chs) for g, chs in groups if any(channel_of(c.name) for c in chs)]
     if len(ours) != 1:
         raise ExperimentFileError(path, None, f"{len(ours)} groups hold Table 2 channels "
@@ -64,6 +70,32 @@ def read(path, strain_scale: dict | None = None):
             if k.startswith(META_PREFIX)}
     assumed = [ch for ch, u in zip(channels, units) if u is None]
     return record(path, t, np.column_stack(data), channels, factors, meta, assumed)
+
+
+@contextlib.contextmanager
+def _warnings_of(prefix: str):
+    """Collect the warnings the loggers of a library (names starting ``prefix``) log,
+    instead of letting them print, into a list."""
+    messages: list[str] = []
+
+    class Collect(logging.Handler):
+        def emit(self, record):
+            if record.levelno >= logging.WARNING:
+                messages.append(record.getMessage())
+
+    collect = Collect()
+    loggers = [logging.getLogger(name) for name in list(logging.root.manager.loggerDict)
+               if name == prefix or name.startswith(prefix + ".")]
+    saved = [(log, log.handlers[:], log.propagate) for log in loggers]
+    for log in loggers:
+        log.handlers[:] = [collect]
+        log.propagate = False
+    try:
+        yield messages
+    finally:
+        for log, handlers, propagate in saved:
+            log.handlers[:] = handlers
+            log.propagate = propagate
 
 
 def _unit(channel) -> str | None:
