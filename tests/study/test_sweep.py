@@ -369,3 +369,15 @@ def test_kill_9_of_the_sweep_leaves_no_worker_computing(tmp_path):
             os.killpg(proc.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
+
+
+def test_the_code_version_covers_the_kernels_and_the_model_not_the_presentation():
+    """A sweep reuses a point only if the code that computes it is unchanged."""
+    from workbench.study.provenance import computing_sources
+
+    names = {p.relative_to(p.parents[1]).as_posix() for p in computing_sources()}
+    for computing in ("core/hybrid.py", "core/config.py", "model/simulate.py", "model/params.py",
+                      "study/sweep.py", "study/metrics.py"):
+        assert computing in names
+    for presenting in ("present/figures.py", "experiments/files.py", "cli.py"):
+        assert presenting not in names

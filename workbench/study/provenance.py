@@ -8,25 +8,27 @@ import os
 import platform
 from pathlib import Path
 
-_PACKAGE = Path(__file__).resolve().parent
+_PACKAGE = Path(__file__).resolve().parents[1]          # workbench/
 PACKAGES = ("numba", "numpy", "scipy", "pandas", "joblib", "pyarrow", "matplotlib")
-#: Modules that only present results: a change to them keeps computed points valid.
-PRESENTATION = frozenset({"figures.py", "tables.py", "report.py", "points.py", "cli.py",
-                          "__main__.py", "provenance.py"})
+#: The sub-packages whose code computes a sweep's points; the others (present/,
+#: experiments/, identify/, reference/, the command line) only read or present them.
+COMPUTING = ("core", "model", "study")
+
+
+def computing_sources() -> list[Path]:
+    """The source files :func:`code_version` hashes, sorted."""
+    return sorted(p for sub in COMPUTING for p in (_PACKAGE / sub).rglob("*.py"))
 
 
 @functools.lru_cache(maxsize=1)
 def code_version() -> str:
-    """A hash of every source file of the package that computes results (16 hex digits).
+    """A hash of every source file that computes results (:data:`COMPUTING`; 16 hex digits).
 
-    Part of each sweep point's key: results of other code are not reused.
-    The presentation modules (:data:`PRESENTATION`) are left out, so that a
-    new figure does not recompute a grid.
+    Part of each sweep point's key: results of other code are not reused,
+    while a new figure or file format does not recompute a grid.
     """
     h = hashlib.sha256()
-    for path in sorted(_PACKAGE.rglob("*.py")):
-        if path.parent == _PACKAGE and path.name in PRESENTATION:
-            continue
+    for path in computing_sources():
         h.update(str(path.relative_to(_PACKAGE)).encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:16]
