@@ -10,6 +10,7 @@ gives one ``Y_Unit_Label`` per channel; a channel without one is read in
 """
 from __future__ import annotations
 
+import ast
 import datetime as _dt
 from pathlib import Path
 
@@ -106,7 +107,6 @@ def _segments(raw: list[str], sep: str) -> list[dict]:
 
 def _bad_literal_line(raw, sep) -> int | None:
     """The line of a Samples / X0 / Delta_X value lvm_read cannot evaluate, if there is one."""
-    import ast
     for n, line in enumerate(raw, 1):
         cells = line.rstrip("\n").split(sep)
         if cells[0] in ("Samples", "X0", "Delta_X", "Channels"):
@@ -131,8 +131,9 @@ def _segment(path, lines, sep, decimal, x_columns, seg: dict, where: dict, strai
         raise ExperimentFileError(path, head, f"Channels {n_ch!r}: must be a whole number >= 1")
     names = [n.strip() for n in seg["Channel names"]]
     if x_columns == "One":
-        if not names or names[0].lower() not in ("x_value",):
-            raise ExperimentFileError(path, where["names"], "the first column must be X_Value (time)")
+        if not names or names[0].lower() != "x_value":
+            raise ExperimentFileError(path, where["names"],
+                                      "the first column must be X_Value (time)")
         names = names[1:]
     if names and names[-1] in ("Comment", ""):
         names = names[:-1]
@@ -163,7 +164,8 @@ def _segment(path, lines, sep, decimal, x_columns, seg: dict, where: dict, strai
         if len(bad):
             text = cells[bad[0]].strip(" ")
             number(path, n, columns[bad[0]], text, decimal)       # says why, if float() agrees
-            raise ExperimentFileError(path, n, f"column {columns[bad[0]]!r}: {text!r} is not a number")
+            raise ExperimentFileError(path, n, f"column {columns[bad[0]]!r}: {text!r} is not "
+                                      "a number")
     declared = _per_channel(path, head, seg.get("Samples", []), "Samples", n_ch)
     if any(_given(d) and d != len(data) for d in declared):
         raise ExperimentFileError(path, head, f"the segment declares {declared[0]} samples but has "
@@ -188,8 +190,7 @@ def _given(value) -> bool:
 def _per_channel(path, line, values: list, key: str, n_ch: int) -> list:
     """One value per channel of a segment header line (one value counts for all)."""
     values = list(values)
-    while values and (values[-1] == "" or (isinstance(values[-1], float) and np.isnan(values[-1]))) \
-            and len(values) > n_ch:
+    while len(values) > n_ch and (values[-1] == "" or _is_nan(values[-1])):
         values.pop()
     if not values:
         return [""] * n_ch
@@ -198,9 +199,14 @@ def _per_channel(path, line, values: list, key: str, n_ch: int) -> list:
     if len(values) != n_ch:
         raise ExperimentFileError(path, line, f"{key} has {len(values)} values for {n_ch} channels")
     for v in values:
-        if key != "Y_Unit_Label" and not (_given(v) or (isinstance(v, float) and np.isnan(v))):
+        if key != "Y_Unit_Label" and not (_given(v) or _is_nan(v)):
             raise ExperimentFileError(path, line, f"{key} {v!r} is not a number")
     return values
+
+
+def _is_nan(value) -> bool:
+    """lvm_read's value of an empty numeric field."""
+    return isinstance(value, float) and np.isnan(value)
 
 
 def _is_number(text: str) -> bool:
