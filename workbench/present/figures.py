@@ -321,10 +321,10 @@ def frf_figure(tables, responses, title: str, f_max: float | None = None):
         axes[0, j].set_title(r, fontsize=9)
         axes[0, j].legend(fontsize=8)
         axes[0, j].grid(alpha=0.3, which="both")
-        axes[1, j].set_ylabel("phase H1 (deg)")
         axes[2, j].set_ylim(0, 1.05)
-        axes[2, j].set_ylabel("coherence")
         axes[2, j].set_xlabel("frequency (Hz)")
     axes[0, 0].set_ylabel("|H| (response unit / force unit)")
+    axes[1, 0].set_ylabel("phase H1 (deg)")
+    axes[2, 0].set_ylabel("coherence")
     fig.suptitle(title, fontsize=10)
     return fig
