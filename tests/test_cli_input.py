@@ -90,6 +90,7 @@ CASES = [
     (["run", "--set", "gap_mm=1" + "0" * 400], ["--set gap_mm=1000", "too large"]),
     (["run", "--duration", "1e308"], ["--duration", "1e308"]),
     (["frf", "R", "--segment-s", "1e308"], ["--segment-s", "1e+308", "allowed"]),
+    (["run", "--out", "1" + "0" * 400], ["--out 1000"]),           # a name too long to stat
     (["run", "--dt", "1e-300"], ["--dt", "1e-300"]),
     (["run", "--dt", "1e-3"], ["--dt", "stability limit"]),
     (["run", "--dt", "abc"], ["--dt", "'abc'"]),

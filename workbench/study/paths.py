@@ -48,12 +48,12 @@ def check_output_dir(option: str, folder: str | os.PathLike) -> Path:
 def check_output_file(option: str, file: str | os.PathLike, suffixes=()) -> Path:
     """``file`` can be written: its folder exists, it is not a folder, its suffix is known."""
     path = Path(file)
-    if path.is_dir():
+    if os.path.isdir(path):              # False, not OSError, for a name too long
         raise ParameterError(f"{option} {file}: is a folder; give a file name")
     if suffixes and path.suffix.lower() not in suffixes:
         raise ParameterError(f"{option} {file}: the suffix must be one of {', '.join(suffixes)}")
     parent = path.parent
-    if not parent.is_dir():
+    if not os.path.isdir(parent):
         anc = _existing_ancestor(parent)
         problem = "does not exist" if anc.is_dir() else f"is inside {anc}, which is a file"
         raise ParameterError(f"{option} {file}: the folder {parent} {problem}")
