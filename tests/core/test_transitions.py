@@ -6,6 +6,8 @@ never add kinetic energy and leave no closed point approaching; the
 accumulations, inconsistent regimes and event floods of the runs that once failed
 end in finished runs with every impact dissipative.
 """
+import math
+
 import numpy as np
 import pytest
 
@@ -14,10 +16,12 @@ from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import kinetic_energy
 from workbench.core.dynamics import cork_energy, cork_force, eval_inertia
+from workbench.core.config import STEPPED_STEPS
+from workbench.core.hybrid import _stepped
 from workbench.core.transitions import moreau_jean_step
 from workbench.model.modes import linear_eigenvalues
 from workbench.model.params import ParameterError, Parameters
-from workbench.model.simulate import CONTACT_STAT_KEYS, simulate
+from workbench.model.simulate import CONTACT_STAT_KEYS, default_dt, simulate, stepped_dt
 
 
 @pytest.mark.parametrize("cork", ["none", "linear", "cubic"])
@@ -85,6 +89,37 @@ def test_moreau_jean_step_is_plastic_and_dissipative():
     ke_after = kinetic_energy(after[ly.N_DOF:ly.N_STATE], work.mat)
     eval_inertia(y[:ly.N_DOF], y[ly.N_DOF:ly.N_STATE], *model, *work)
     assert ke_after < kinetic_energy(y[ly.N_DOF:ly.N_STATE], work.mat)
+
+
+@pytest.mark.parametrize("tip_mass", [False, True])
+def test_moreau_jean_episode_keeps_the_axial_modes_bounded(tip_mass):
+    """An event flood's Moreau-Jean episode (STEPPED_STEPS + 1 kernel steps) in free flight.
+
+    The scheme is explicit in the elastic forces, stable for omega h < 2:
+    at the default step without the tip mass omega h = 2.2 for the axial
+    mode, whose rate then grew from 1 to 3.7 cm/s in 11 steps.  Split into steps of at
+    most stepped_dt, the axial rate must not grow (the mode is damped).
+    """
+    p = Parameters(cork="cubic", tip_mass=tip_mass).replace(gap_mm=1.016)
+    model, work = mdl.build(p), mdl.make_work()
+    dt = default_dt(p)
+
+    def episode(limit):
+        model.P[ly.P_STEPPED_DT] = limit
+        y = work.stages[ly.STAGE_CUR]
+        y[:] = 0.0
+        y[ly.N_DOF + ly.U_A] = y[ly.N_DOF + ly.U_B] = 1.0     # axial rates (cm/s), free flight
+        work.rg[:] = 0.0
+        st = np.zeros(ly.N_ST)
+        for k in range(STEPPED_STEPS + 1):
+            assert _stepped(k * dt, dt, *model, X.none(), *work, st) == ly.OK
+        return max(abs(y[ly.N_DOF + ly.U_A]), abs(y[ly.N_DOF + ly.U_B])), st[ly.ST_N_STEPPED]
+
+    rate, n_steps = episode(stepped_dt(p))
+    assert rate <= 1.0
+    assert n_steps == (STEPPED_STEPS + 1) * math.ceil(dt / stepped_dt(p)) >= 2 * (STEPPED_STEPS + 1)
+    if not tip_mass:                        # one step per kernel step: the mode grows
+        assert episode(math.inf)[0] > 2.0
 
 
 def hard_run(force_n, freq_hz, duration, **changes):

@@ -32,11 +32,14 @@ so the micro-collisions end in the persistent contact.  A watched gap
 that is already closed is an impact only while it approaches faster than
 CLOSED_RATE.  More than MAX_EVENTS_PER_STEP events in one step hand the
 rest of the step and STEPPED_STEPS more to Moreau-Jean time-stepping
-(:func:`workbench.core.transitions.moreau_jean_step`).  Each event is
+(:func:`workbench.core.transitions.moreau_jean_step`, in sub-steps of at
+most P[P_STEPPED_DT]).  Each event is
 written to the log (layout ``LOG_*``); failures (NaN, a mass matrix that
 is not positive definite) end the run with a status code, keeping the
 samples and the log written so far.
 """
+import math
+
 import numba as nb
 
 from .config import (ACCUM_GAP_TOL, ACCUM_STEPS, CLOSED_RATE, EVENT_TIME_TOL, GAP_TOL,
@@ -431,10 +434,22 @@ def _immediate_impact(ev):
 
 @nb.njit(**JIT)
 def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st):
-    """A Moreau-Jean step of h from (t, STAGE_CUR), then the regime chosen at t + h."""
-    status = moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st)
-    if status != ly.OK:
-        return status
+    """Moreau-Jean steps over h from (t, STAGE_CUR), then the regime chosen at t + h.
+
+    The scheme is explicit in the smooth forces (leapfrog-like, stable for
+    omega h < 2): h is split into the fewest equal steps of at most
+    P[P_STEPPED_DT], which the model's fastest linear mode sets
+    (:func:`workbench.model.simulate.stepped_dt`); the integration step
+    itself may exceed it (RK4 is stable to omega h = 2.83).
+    """
+    n = 1
+    if h > P[ly.P_STEPPED_DT]:
+        n = int(math.ceil(h / P[ly.P_STEPPED_DT]))
+    for k in range(n):
+        status = moreau_jean_step(t + k * (h / n), h / n, P, tab, kc, free, ex, rec, mat, vec,
+                                  stages, cg, cw, rg, st)
+        if status != ly.OK:
+            return status
     status = choose_regime(t + h, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec, stages,
                            cg, cw, rg, stages[ly.STAGE_K1], st, GAP_TOL)
     if status == ly.OK:

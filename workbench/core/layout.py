@@ -64,7 +64,8 @@ P_C_AX_A = 38    # beam A axial damping on u_A (g/s)
 P_C_AX_B = 39    # beam B axial damping on u_B (g/s)
 P_S_TRAVEL = 40  # slide before the slot's end stop, each way (cm; inf for none)
 P_K_STOP = 41    # end-stop stiffness beyond |s| > s_travel (g/s^2)
-N_PARAMS = 42
+P_STEPPED_DT = 42  # largest Moreau-Jean step (s); inf until simulate sets it from the model's modes
+N_PARAMS = 43
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):

@@ -16,6 +16,7 @@ joint coordinates, so ``fixed=JOINT`` is the locked joint of docs/model.md.
 """
 from __future__ import annotations
 
+import math
 from collections import namedtuple
 from collections.abc import Iterable
 
@@ -79,6 +80,8 @@ def pack(p: Parameters) -> np.ndarray:
     P[ly.P_C_STRAIN] = p.c_strain
     P[ly.P_N_GAUSS] = p.n_gauss
     P[ly.P_X_ACCEL1], P[ly.P_X_ACCEL2] = p.x_accel1, p.x_accel2
+    # needs the linear eigenvalues, which need this array: workbench.model.simulate sets it
+    P[ly.P_STEPPED_DT] = math.inf
     return P
 
 
