@@ -1,9 +1,9 @@
 """Accuracy against cost of two checkouts' integrators on the same windows.
 
-    python benchmarks/accuracy_side_by_side.py windows /tmp/windows.npz
-    python benchmarks/accuracy_side_by_side.py measure /tmp/windows.npz 2e-4 1e-4
+    python benchmarks/accuracy_side_by_side.py windows /tmp/windows.json
+    python benchmarks/accuracy_side_by_side.py measure /tmp/windows.json 2e-4 1e-4
     (cd /tmp/old && PYTHONPATH=/tmp/old python /path/to/accuracy_side_by_side.py \\
-        measure /tmp/windows.npz 1e-4 5e-5)
+        measure /tmp/windows.json 1e-4 5e-5)
 
 ``windows`` runs each case whole at this checkout's default step, takes the
 window of :func:`side_by_side.window_start` (a 0.25 s span from a state clear
@@ -15,6 +15,10 @@ over the converged tip's range, the largest contact-share difference and
 the events.  It uses only ``simulate``, so it runs in an older checkout too
 (put that checkout first on PYTHONPATH): both are then measured against the
 same converged solution, alternately, on the same machine.
+
+``measure ... --held u_A,u_B`` holds those coordinates at their values at the
+window's start (their rates zeroed): a reduced model measured against the
+converged full model.
 """
 from __future__ import annotations
 
@@ -64,10 +68,15 @@ def _window_start(run, after: float):
     raise RuntimeError(f"no window after {after} s")
 
 
-def window(params, ex, t0, y0, regime, dt):
+def window(params, ex, t0, y0, regime, dt, held=()):
+    """One window at step dt; ``held`` coordinates are held at their start (rates zeroed)."""
+    if held:
+        y0 = np.array(y0, dtype=float)
+        for name in held:
+            y0[len(COLUMNS) + COLUMNS.index(name)] = 0.0
     start = time.perf_counter()
     run = simulate(params, ex, WINDOW_S, dt=dt, output_hz=SAMPLE_HZ, initial=y0, t0=t0,
-                   regime=regime)
+                   regime=regime, fixed=held)
     wall = time.perf_counter() - start
     if not run.ok:
         raise RuntimeError(f"window at dt = {dt}: {run.message}")
@@ -102,7 +111,7 @@ def save_windows(path):
         json.dump(out, f)
 
 
-def measure(path, steps):
+def measure(path, steps, held=()):
     with open(path) as f:
         saved = json.load(f)
     for name, (params, ex, _, _) in cases().items():
@@ -112,13 +121,13 @@ def measure(path, steps):
             try:
                 for _ in range(RUNS):
                     wall, tip, shares, n_events = window(params, ex, w["t0"], np.array(w["y0"]),
-                                                         w["regime"], dt)
+                                                         w["regime"], dt, held)
                     walls.append(wall)
             except Exception as exc:          # an unstable or refused step: say so, go on
                 print(json.dumps({"case": name, "dt": dt, "failed": str(exc)}), flush=True)
                 continue
             tip_err, share_err = errors(tip, shares, np.array(w["tip"]), w["shares"])
-            print(json.dumps({"case": name, "dt": dt,
+            print(json.dumps({"case": name, "dt": dt, "held": list(held),
                               "wall_per_sim_s": statistics.median(walls) / WINDOW_S,
                               "tip_error_rel": tip_err, "share_error": share_err,
                               "events": n_events, "converged_events": w["events"]}), flush=True)
@@ -128,4 +137,6 @@ if __name__ == "__main__":
     if sys.argv[1] == "windows":
         save_windows(sys.argv[2])
     else:
-        measure(sys.argv[2], [float(a) for a in sys.argv[3:]])
+        args = sys.argv[3:]
+        held = tuple(args[args.index("--held") + 1].split(",")) if "--held" in args else ()
+        measure(sys.argv[2], [float(a) for a in args if a[0].isdigit()], held)
