@@ -8,8 +8,8 @@ terminal, + to -), the transition applied by the kernel's own
 ``apply_event`` (projection, Moreau's impact law, regime choice) and a
 restart.  Same model, same transitions: only the integration differs.
 
-    python benchmarks/lsoda_side_by_side.py accuracy /tmp/windows.json 1e-5 1e-6 1e-7
-    python benchmarks/lsoda_side_by_side.py speed 1e-7 [--no-tip] [--force 200] [--rounds 3]
+    python benchmarks/lsoda_side_by_side.py accuracy /tmp/windows.json 1e-2 1e-3 1e-4
+    python benchmarks/lsoda_side_by_side.py speed 1e-3 [--no-tip] [--force 200] [--rounds 3]
 
 ``accuracy`` runs the windows saved by ``accuracy_side_by_side.py windows``
 at each rtol (atol = ATOL_REL * rtol), and prints the tip-height error over
@@ -30,15 +30,15 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from workbench.core import layout as ly
-from workbench.core.config import CLOSED_RATE, EVENT_TIME_TOL, MAX_EVENTS_PER_STEP, STEPPED_STEPS
+from workbench.core.config import EVENT_TIME_TOL, GAP_TOL, MAX_EVENTS_PER_STEP, STEPPED_STEPS
 from workbench.core.constrained import rhs_regime
-from workbench.core.hybrid import _stepped, apply_event, event_values
+from workbench.core.hybrid import _immediate_impact, _stepped, apply_event, event_values
 from workbench.core.sensors import fill_signals
 from workbench.core.transitions import choose_regime
 from workbench.model import packing as mdl
 from workbench.model.excitation import sine
 from workbench.model.params import Parameters
-from workbench.model.regimes import is_stick, regime_of, set_of
+from workbench.model.regimes import contact_code, is_stick, regime_of, set_of
 from workbench.model.simulate import default_dt, simulate, stepped_dt
 
 #: atol of every state component = ATOL_REL * rtol (cm, rad, cm/s, rad/s):
@@ -115,12 +115,7 @@ class CompiledLSODA:
                                  w.stages, w.cg, w.cw, w.rg, w.ev, self.log, 0, self.st)
             if status != ly.OK:
                 raise RuntimeError(f"apply_event status {status} at t = {t}")
-            e = -1
-            for p in range(ly.N_POINTS):        # the kernel's immediate impacts
-                if (w.ev[ly.EV_START, ly.EV_GAP + p] < 0.0
-                        and w.ev[ly.EV_RATE_START, ly.EV_GAP + p] < -CLOSED_RATE):
-                    e = ly.EV_GAP + p
-                    break
+            e = _immediate_impact(w.ev)
         self.key = None
         return cur[:ly.N_STATE].copy()
 
@@ -173,7 +168,7 @@ class CompiledLSODA:
         self.y[:] = 0.0
         self.y[:ly.N_STATE] = y0
         status = choose_regime(t0, self.y, *self.model, self.ex, w.rec, w.mat, w.vec, w.stages,
-                               w.cg, w.cw, w.rg, w.stages[ly.STAGE_K1], self.st, 1e-7)
+                               w.cg, w.cw, w.rg, w.stages[ly.STAGE_K1], self.st, GAP_TOL)
         if status != ly.OK:
             raise RuntimeError(f"choose_regime status {status}")
         t, y = t0, self.y[:ly.N_STATE].copy()
@@ -214,7 +209,6 @@ class CompiledLSODA:
                 t, y = self._stepped_episode(t, t1, y, sample_times, times, tips, shares)
                 recent = []
         total = sum(shares.values())
-        from workbench.model.regimes import contact_code
         by_code = {}
         for reg, span in shares.items():
             code = int(contact_code(reg))
