@@ -45,7 +45,9 @@ def test_falling_across_the_gap_closed_form():
     assert len(impacts) == 1
     t_hit = math.sqrt(p.gap / p.g)                      # gap/2 = g t^2 / 2
     assert abs(impacts.t.iloc[0] - t_hit) < 1e-9
-    assert impacts.point.iloc[0] == 1
+    # gaps 1 and 3 are the same function of v here (psi held): they close at the
+    # same instant up to round-off, and either may be the one located first
+    assert impacts.point.iloc[0] in (1, 3)
     v_hit = p.g * t_hit
     ke = 0.5 * loose_mass(p) * v_hit ** 2
     assert impacts.ke_lost.iloc[0] == pytest.approx(ke, rel=1e-8)

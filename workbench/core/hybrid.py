@@ -195,12 +195,18 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
 def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """Locate event e's sign change in (0, hi) by the Illinois method, to EVENT_TIME_TOL.
 
+    Secant steps converge on one side of the root; a step that would land
+    within EVENT_TIME_TOL / 2 of an end of the bracket is moved to that
+    distance inside it, so that the bracket closes once the secant has
+    converged.
+
     ``flo`` >= 0 is its value at the step's start, ``fhi`` < 0 at ``hi``,
     whose state is in STAGE_HI.  Returns ``(status, theta)``: the state just
     past the change (theta) is left in STAGE_HI, the events there in EV_HI.
     """
     lo = 0.0
     side = 0
+    nudge = 0.5 * EVENT_TIME_TOL / h
     for it in range(200):
         if (hi - lo) * h <= EVENT_TIME_TOL:
             break
@@ -210,6 +216,13 @@ def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages,
             x = hi - fhi * (hi - lo) / (fhi - flo)
             if not (lo < x < hi):
                 x = 0.5 * (lo + hi)
+            # a secant step that lands within half the tolerance of an end is
+            # moved to that distance inside it, so that the next state falls on
+            # the root's other side and closes the bracket (Brent's guard)
+            elif x - lo < nudge:
+                x = lo + nudge
+            elif hi - x < nudge:
+                x = hi - nudge
         status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, hi

@@ -25,14 +25,14 @@ import numba as nb
 
 from .config import JIT_INLINE
 from . import layout as ly
-from .kinematics import beam_point_local, tip_row
+from .kinematics import tip_row
 
 # Accumulator layout: a row of ``rec`` (REC_ACC), reset per frame.  The
 # rotary inertia enters as a third Jacobian row (the angle row a + d).
 A_M = 0                 # sum m (g)
 A_C = 1                 # c = sum m rho (2)
 A_E = 3                 # sum m D, rows x then y, 3 local columns each (6)
-A_G = 9                 # sum m D^T D + I d d^T, 3 x 3 (9)
+A_G = 9                 # sum m D^T D + I d d^T, 3 x 3 row-major, upper triangle used (9)
 A_F3 = 18               # sum m (S rho)^T D + I d (3)
 A_B22 = 21              # sum m |rho|^2 + I
 A_L = 22                # sum m ell, ell the local convective acceleration (2)
@@ -49,38 +49,77 @@ def _reset(acc):
 
 
 @nb.njit(**JIT_INLINE)
-def _add_point(acc, m, rot, p, i0, beam, d0, d1, d2, omega):
-    """Add a point of a frame: mass m (g), rotary inertia rot (g cm^2).
+def _add_rigid_point(acc, m, rot, rx, ry, omega):
+    """Add a point fixed in a frame: mass m (g), rotary inertia rot (g cm^2) at (rx, ry) (cm).
 
-    ``p`` is its record in the frame's axes (position, and for a beam point
-    velocity, convective acceleration and Jacobian on columns i0..i0+2);
-    ``d`` its own angle derivatives on those columns; ``omega`` the frame's
-    angle rate (rad/s).
+    Its D and d are zero and its convective acceleration ell = -omega^2 rho
+    (omega the frame's angle rate, rad/s) is parallel to rho, so only the
+    mass, first and second moments and sum m ell change.
     """
-    rx = p[ly.RX]
-    ry = p[ly.RY]
     acc[A_M] += m
     acc[A_C] += m * rx
     acc[A_C + 1] += m * ry
     acc[A_B22] += m * (rx * rx + ry * ry) + rot
-    # ell = rho''_conv + 2 omega S rho' - omega^2 rho  (a rigid point: the last term only)
-    lx = -omega * omega * rx
-    ly_ = -omega * omega * ry
-    d = (d0, d1, d2)
-    if beam:
-        lx += p[ly.KX] - 2.0 * omega * p[ly.VY]
-        ly_ += p[ly.KY] + 2.0 * omega * p[ly.VX]
-    for j in range(3):
-        dxj = p[ly.JX + i0 + j] if beam else 0.0
-        dyj = p[ly.JY + i0 + j] if beam else 0.0
-        acc[A_E + j] += m * dxj
-        acc[A_E + 3 + j] += m * dyj
-        acc[A_F3 + j] += m * (-ry * dxj + rx * dyj) + rot * d[j]
-        acc[A_DL + j] += m * (dxj * lx + dyj * ly_)
-        for k in range(3):
-            dxk = p[ly.JX + i0 + k] if beam else 0.0
-            dyk = p[ly.JY + i0 + k] if beam else 0.0
-            acc[A_G + 3 * j + k] += m * (dxj * dxk + dyj * dyk) + rot * d[j] * d[k]
+    acc[A_L] -= m * omega * omega * rx
+    acc[A_L + 1] -= m * omega * omega * ry
+
+
+@nb.njit(**JIT_INLINE)
+def _add_beam_point(acc, m, rot, row, q, qd, i0, x_offset, d0, d1, omega):
+    """Add a point of a beam (a shape-table row) to its root frame's sums.
+
+    Mass m (g), rotary inertia rot (g cm^2); ``i0`` the beam's first
+    coordinate, ``x_offset`` its root along the frame's x axis (cm), (d0, d1)
+    the point's own angle derivatives on (w, phi), ``omega`` the frame's
+    angle rate (rad/s).  The kinematics of
+    :func:`~workbench.core.kinematics.beam_point_local`, written out: on the
+    beam's (w, phi, u) the Jacobian rows are D_x = (-(Sigma b)_0,
+    -(Sigma b)_1, xi) and D_y = (N1, N2, 0), so only their nonzero entries
+    and the upper triangle of sum m D^T D are formed.
+    """
+    w = q[i0]
+    phi = q[i0 + 1]
+    wd = qd[i0]
+    phid = qd[i0 + 1]
+    s00 = row[ly.T_S00]
+    s01 = row[ly.T_S01]
+    s11 = row[ly.T_S11]
+    xi = row[ly.T_XI]
+    n1 = row[ly.T_N1]
+    n2 = row[ly.T_N2]
+    sb0 = s00 * w + s01 * phi
+    sb1 = s01 * w + s11 * phi
+    rx = x_offset + row[ly.T_X] + xi * q[i0 + 2] - 0.5 * (w * sb0 + phi * sb1)
+    ry = n1 * w + n2 * phi
+    vx = -sb0 * wd - sb1 * phid + xi * qd[i0 + 2]
+    vy = n1 * wd + n2 * phid
+    kx = -(s00 * wd * wd + 2.0 * s01 * wd * phid + s11 * phid * phid)
+    # ell = rho''_conv + 2 omega S rho' - omega^2 rho
+    lx = kx - 2.0 * omega * vy - omega * omega * rx
+    ly_ = 2.0 * omega * vx - omega * omega * ry
+    x0 = -sb0
+    x1 = -sb1
+    acc[A_M] += m
+    acc[A_C] += m * rx
+    acc[A_C + 1] += m * ry
+    acc[A_B22] += m * (rx * rx + ry * ry) + rot
+    acc[A_E] += m * x0
+    acc[A_E + 1] += m * x1
+    acc[A_E + 2] += m * xi
+    acc[A_E + 3] += m * n1
+    acc[A_E + 4] += m * n2
+    acc[A_F3] += m * (-ry * x0 + rx * n1) + rot * d0
+    acc[A_F3 + 1] += m * (-ry * x1 + rx * n2) + rot * d1
+    acc[A_F3 + 2] -= m * ry * xi
+    acc[A_DL] += m * (x0 * lx + n1 * ly_)
+    acc[A_DL + 1] += m * (x1 * lx + n2 * ly_)
+    acc[A_DL + 2] += m * xi * lx
+    acc[A_G] += m * (x0 * x0 + n1 * n1) + rot * d0 * d0
+    acc[A_G + 1] += m * (x0 * x1 + n1 * n2) + rot * d0 * d1
+    acc[A_G + 2] += m * x0 * xi
+    acc[A_G + 4] += m * (x1 * x1 + n2 * n2) + rot * d1 * d1
+    acc[A_G + 5] += m * x1 * xi
+    acc[A_G + 8] += m * xi * xi
     acc[A_L] += m * lx
     acc[A_L + 1] += m * ly_
     acc[A_SL] += m * (-ry * lx + rx * ly_)
@@ -164,40 +203,32 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
     The frames in ``rec`` must be current (:func:`~.kinematics.compute_frames`).
     """
     acc = rec[ly.REC_ACC]
-    loc = rec[ly.REC_LOCAL]
     g = P[ly.P_GRAV]
     ng = int(P[ly.P_N_GAUSS])
     # beam A: the ground frame
     _reset(acc)
     for k in range(ng):
         row = tab[k]
-        beam_point_local(row, q, qd, ly.W_A, 0.0, rec, ly.REC_LOCAL)
         w = row[ly.T_WEIGHT]
-        _add_point(acc, P[ly.P_MU_A] * w, P[ly.P_RHOI_A] * w, loc, ly.W_A, True,
-                   row[ly.T_DN1], row[ly.T_DN2], 0.0, 0.0)
+        _add_beam_point(acc, P[ly.P_MU_A] * w, P[ly.P_RHOI_A] * w, row, q, qd, ly.W_A, 0.0,
+                        row[ly.T_DN1], row[ly.T_DN2], 0.0)
     v_grav = _add_frame(acc, rec[ly.REC_JOINT], rec[ly.REC_U], False, ly.W_A, g, M, h, Q)
     # joint body: a rigid point of the joint frame
     fj = rec[ly.REC_JOINT]
     _reset(acc)
-    loc[ly.RX] = P[ly.P_C3]
-    loc[ly.RY] = 0.0
-    _add_point(acc, P[ly.P_M3], P[ly.P_I3], loc, ly.W_A, False, 0.0, 0.0, 0.0, fj[ly.RATE])
+    _add_rigid_point(acc, P[ly.P_M3], P[ly.P_I3], P[ly.P_C3], 0.0, fj[ly.RATE])
     v_grav += _add_frame(acc, fj, rec[ly.REC_U], True, ly.W_A, g, M, h, Q)
     # loose body, beam B and the tip mass: the loose-body frame
     fl = rec[ly.REC_LOOSE]
     omega = fl[ly.RATE]
     _reset(acc)
-    loc[ly.RX] = P[ly.P_C4]
-    loc[ly.RY] = 0.0
-    _add_point(acc, P[ly.P_M4], P[ly.P_I4], loc, ly.W_B, False, 0.0, 0.0, 0.0, omega)
+    _add_rigid_point(acc, P[ly.P_M4], P[ly.P_I4], P[ly.P_C4], 0.0, omega)
     for k in range(ng):
         row = tab[ng + k]
-        beam_point_local(row, q, qd, ly.W_B, P[ly.P_L4], rec, ly.REC_LOCAL)
         w = row[ly.T_WEIGHT]
-        _add_point(acc, P[ly.P_MU_B] * w, P[ly.P_RHOI_B] * w, loc, ly.W_B, True,
-                   row[ly.T_DN1], row[ly.T_DN2], 0.0, omega)
-    beam_point_local(tab[tip_row(P, ly.R_TIP_B)], q, qd, ly.W_B, P[ly.P_L4], rec, ly.REC_LOCAL)
-    _add_point(acc, P[ly.P_M6], P[ly.P_I6], loc, ly.W_B, True, 0.0, 1.0, 0.0, omega)
+        _add_beam_point(acc, P[ly.P_MU_B] * w, P[ly.P_RHOI_B] * w, row, q, qd, ly.W_B,
+                        P[ly.P_L4], row[ly.T_DN1], row[ly.T_DN2], omega)
+    _add_beam_point(acc, P[ly.P_M6], P[ly.P_I6], tab[tip_row(P, ly.R_TIP_B)], q, qd, ly.W_B,
+                    P[ly.P_L4], 0.0, 1.0, omega)
     v_grav += _add_frame(acc, fl, rec[ly.REC_U], True, ly.W_B, g, M, h, Q)
     return v_grav
-
