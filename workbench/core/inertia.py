@@ -25,7 +25,7 @@ import numba as nb
 
 from .config import JIT_INLINE
 from . import layout as ly
-from .kinematics import tip_row
+from .kinematics import beam_point_motion, tip_row
 
 # Accumulator layout: a row of ``rec`` (REC_ACC), reset per frame.  The
 # rotary inertia enters as a third Jacobian row (the angle row a + d).
@@ -72,28 +72,15 @@ def _add_beam_point(acc, m, rot, row, q, qd, i0, x_offset, d0, d1, omega):
     coordinate, ``x_offset`` its root along the frame's x axis (cm), (d0, d1)
     the point's own angle derivatives on (w, phi), ``omega`` the frame's
     angle rate (rad/s).  The kinematics of
-    :func:`~workbench.core.kinematics.beam_point_local`, written out: on the
+    :func:`~workbench.core.kinematics.beam_point_motion`; on the
     beam's (w, phi, u) the Jacobian rows are D_x = (-(Sigma b)_0,
     -(Sigma b)_1, xi) and D_y = (N1, N2, 0), so only their nonzero entries
     and the upper triangle of sum m D^T D are formed.
     """
-    w = q[i0]
-    phi = q[i0 + 1]
-    wd = qd[i0]
-    phid = qd[i0 + 1]
-    s00 = row[ly.T_S00]
-    s01 = row[ly.T_S01]
-    s11 = row[ly.T_S11]
+    rx, ry, vx, vy, kx, sb0, sb1 = beam_point_motion(row, q, qd, i0, x_offset)
     xi = row[ly.T_XI]
     n1 = row[ly.T_N1]
     n2 = row[ly.T_N2]
-    sb0 = s00 * w + s01 * phi
-    sb1 = s01 * w + s11 * phi
-    rx = x_offset + row[ly.T_X] + xi * q[i0 + 2] - 0.5 * (w * sb0 + phi * sb1)
-    ry = n1 * w + n2 * phi
-    vx = -sb0 * wd - sb1 * phid + xi * qd[i0 + 2]
-    vy = n1 * wd + n2 * phid
-    kx = -(s00 * wd * wd + 2.0 * s01 * wd * phid + s11 * phid * phid)
     # ell = rho''_conv + 2 omega S rho' - omega^2 rho
     lx = kx - 2.0 * omega * vy - omega * omega * rx
     ly_ = 2.0 * omega * vx - omega * omega * ry

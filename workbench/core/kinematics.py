@@ -30,20 +30,19 @@ from . import layout as ly
 
 
 @nb.njit(**JIT_INLINE)
-def beam_point_local(row, q, qd, i0, x_offset, rec, dst):
-    """A beam point in the beam's root frame (docs/model.md §4) into ``rec[dst]``.
+def beam_point_motion(row, q, qd, i0, x_offset):
+    """Position (cm), velocity (cm/s) and convective x acceleration (cm/s^2) of a beam point.
 
-    ``row`` a shape-table row, ``i0`` the beam's first coordinate (W_A or
-    W_B), ``x_offset`` the root's position along the frame's x axis (cm).
-    Fills position (cm), velocity (cm/s), convective acceleration (cm/s^2)
-    and the Jacobian d(rho)/dq; the angle row is left alone.
+    In the beam's root frame (docs/model.md §4): ``row`` a shape-table row,
+    ``i0`` the beam's first coordinate, ``x_offset`` the root along the
+    frame's x axis.  Returns ``(rx, ry, vx, vy, kx, sb0, sb1)``, with
+    Sigma b = (sb0, sb1) the foreshortening gradient (the convective y
+    acceleration is 0).
     """
     w = q[i0]
     phi = q[i0 + 1]
-    u = q[i0 + 2]
     wd = qd[i0]
     phid = qd[i0 + 1]
-    ud = qd[i0 + 2]
     s00 = row[ly.T_S00]
     s01 = row[ly.T_S01]
     s11 = row[ly.T_S11]
@@ -52,21 +51,39 @@ def beam_point_local(row, q, qd, i0, x_offset, rec, dst):
     n2 = row[ly.T_N2]
     sb0 = s00 * w + s01 * phi      # (Sigma b)_0
     sb1 = s01 * w + s11 * phi      # (Sigma b)_1
+    rx = x_offset + row[ly.T_X] + xi * q[i0 + 2] - 0.5 * (w * sb0 + phi * sb1)
+    ry = n1 * w + n2 * phi
+    vx = -sb0 * wd - sb1 * phid + xi * qd[i0 + 2]
+    vy = n1 * wd + n2 * phid
+    kx = -(s00 * wd * wd + 2.0 * s01 * wd * phid + s11 * phid * phid)
+    return rx, ry, vx, vy, kx, sb0, sb1
+
+
+@nb.njit(**JIT_INLINE)
+def beam_point_local(row, q, qd, i0, x_offset, rec, dst):
+    """A beam point in the beam's root frame (docs/model.md §4) into ``rec[dst]``.
+
+    ``row`` a shape-table row, ``i0`` the beam's first coordinate (W_A or
+    W_B), ``x_offset`` the root's position along the frame's x axis (cm).
+    Fills position (cm), velocity (cm/s), convective acceleration (cm/s^2)
+    and the Jacobian d(rho)/dq; the angle row is left alone.
+    """
+    rx, ry, vx, vy, kx, sb0, sb1 = beam_point_motion(row, q, qd, i0, x_offset)
     r = rec[dst]
-    r[ly.RX] = x_offset + row[ly.T_X] + xi * u - 0.5 * (w * sb0 + phi * sb1)
-    r[ly.RY] = n1 * w + n2 * phi
-    r[ly.VX] = -sb0 * wd - sb1 * phid + xi * ud
-    r[ly.VY] = n1 * wd + n2 * phid
-    r[ly.KX] = -(s00 * wd * wd + 2.0 * s01 * wd * phid + s11 * phid * phid)
+    r[ly.RX] = rx
+    r[ly.RY] = ry
+    r[ly.VX] = vx
+    r[ly.VY] = vy
+    r[ly.KX] = kx
     r[ly.KY] = 0.0
     for j in range(ly.N_DOF):
         r[ly.JX + j] = 0.0
         r[ly.JY + j] = 0.0
     r[ly.JX + i0] = -sb0
     r[ly.JX + i0 + 1] = -sb1
-    r[ly.JX + i0 + 2] = xi
-    r[ly.JY + i0] = n1
-    r[ly.JY + i0 + 1] = n2
+    r[ly.JX + i0 + 2] = row[ly.T_XI]
+    r[ly.JY + i0] = row[ly.T_N1]
+    r[ly.JY + i0 + 1] = row[ly.T_N2]
 
 
 @nb.njit(**JIT_INLINE)
