@@ -14,8 +14,8 @@ happens, layout ``EV_*``):
     sigma tau' + RATE_EPS                   slip -> stick (or reversal)
 
 A sign change is bracketed by re-integrating the partial step from the
-step's start (one RK4 step of theta dt) and located by the Illinois method
-to EVENT_TIME_TOL.  A gap that dips below zero and back within one step
+step's start (one RK4 step of theta dt) and located by Brent's method to
+EVENT_TIME_TOL.  A gap that dips below zero and back within one step
 (grazing) is caught by the cubic Hermite interpolant of the gap over the
 step: near its minimum the true gap is evaluated by re-integration and its
 minimum followed by the secant method on the gap's rate (:func:`_graze`).  Several events in a
@@ -193,55 +193,75 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
 
 @nb.njit(**JIT)
 def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
-    """Locate event e's sign change in (0, hi) by the Illinois method, to EVENT_TIME_TOL.
+    """Locate event e's sign change in (0, hi) by Brent's method, to EVENT_TIME_TOL.
 
-    Secant steps converge on one side of the root; a step that would land
-    within EVENT_TIME_TOL / 2 of an end of the bracket is moved to that
-    distance inside it, so that the bracket closes once the secant has
-    converged.
+    Brent's zeroin (R. P. Brent, Algorithms for Minimization without
+    Derivatives, 1973, ch. 4): inverse quadratic interpolation through the
+    last three trials, or the secant through two, falling back to bisection
+    when they do not shrink the bracket fast enough.  Every step is at
+    least half the tolerance, so the bracket closes once the interpolation
+    has converged.  ``b`` is the latest trial and ``c`` the latest one on
+    the other side of the change, so the latest state past it (f < 0) is
+    always an end of the bracket.
 
     ``flo`` >= 0 is its value at the step's start, ``fhi`` < 0 at ``hi``,
     whose state is in STAGE_HI.  Returns ``(status, theta)``: the state just
     past the change (theta) is left in STAGE_HI, the events there in EV_HI.
     """
-    lo = 0.0
-    side = 0
-    nudge = 0.5 * EVENT_TIME_TOL / h
-    for it in range(200):
-        if (hi - lo) * h <= EVENT_TIME_TOL:
+    half_tol = 0.5 * EVENT_TIME_TOL / h
+    a, fa = 0.0, flo
+    b, fb = hi, fhi
+    c, fc = a, fa
+    d = b - a
+    last = d
+    for _ in range(200):
+        if abs(fc) < abs(fb):
+            a, fa = b, fb
+            b, fb = c, fc
+            c, fc = a, fa
+        xm = 0.5 * (c - b)
+        if abs(xm) <= half_tol:
             break
-        if it % 5 == 4 or fhi == flo:
-            x = 0.5 * (lo + hi)
+        if abs(last) >= half_tol and abs(fa) > abs(fb):
+            s = fb / fa
+            if a == c:
+                p = 2.0 * xm * s
+                q = 1.0 - s
+            else:
+                q = fa / fc
+                r = fb / fc
+                p = s * (2.0 * xm * q * (q - r) - (b - a) * (r - 1.0))
+                q = (q - 1.0) * (r - 1.0) * (s - 1.0)
+            if p > 0.0:
+                q = -q
+            else:
+                p = -p
+            if 2.0 * p < min(3.0 * xm * q - abs(half_tol * q), abs(last * q)):
+                last = d
+                d = p / q
+            else:
+                d = xm
+                last = d
         else:
-            x = hi - fhi * (hi - lo) / (fhi - flo)
-            if not (lo < x < hi):
-                x = 0.5 * (lo + hi)
-            # a secant step that lands within half the tolerance of an end is
-            # moved to that distance inside it, so that the next state falls on
-            # the root's other side and closes the bracket (Brent's guard)
-            elif x - lo < nudge:
-                x = lo + nudge
-            elif hi - x < nudge:
-                x = hi - nudge
-        status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
+            d = xm
+            last = d
+        a, fa = b, fb
+        if abs(d) > half_tol:
+            b += d
+        else:
+            b += half_tol if xm > 0.0 else -half_tol
+        status = _trial(b, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, hi
-        f = ev[ly.EV_TRY, e]
-        if f < 0.0:
-            hi = x
-            fhi = f
+        fb = ev[ly.EV_TRY, e]
+        if fb < 0.0:
             _copy(stages, ly.STAGE_TRY, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_TRY, ly.EV_HI)
-            if side == -1:
-                flo *= 0.5
-            side = -1
-        else:
-            lo = x
-            flo = f
-            if side == 1:
-                fhi *= 0.5
-            side = 1
-    return ly.OK, hi
+        if (fb < 0.0) == (fc < 0.0):
+            c, fc = a, fa
+            d = b - a
+            last = d
+    return ly.OK, (b if fb < 0.0 else c)
 
 
 @nb.njit(**JIT)
