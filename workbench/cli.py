@@ -332,7 +332,7 @@ def _cmd_sweep(args) -> int:
                "results": str(Path(args.results) / study.name)}
     if not args.no_report:
         from .present.report import make_report
-        summary["report"] = str(make_report(study, args.results))
+        summary["report"] = str(make_report(study, args.results, jobs=args.jobs))
     print(json_text(summary))
     return EXIT_OK if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
 
@@ -365,7 +365,7 @@ def _cmd_report(args) -> int:
     if not (Path(args.results) / study.name / "points.parquet").is_file():
         raise ParameterError(f"report {args.study}: no results in {Path(args.results) / study.name}"
                              f"; run `workbench sweep {args.study} --results {args.results}` first")
-    print(make_report(study, args.results))
+    print(make_report(study, args.results, jobs=args.jobs))
     return EXIT_OK
 
 
@@ -599,7 +599,7 @@ def _cmd_identify_tables(args) -> int:
     from .identify import tables
 
     check_output_dir("--out", args.out)
-    built = tables.build(include_table6=not args.no_table6)
+    built = tables.build(include_table6=not args.no_table6, jobs=args.jobs)
     paths = tables.write(built, args.out)
     agree = {title: dict(t.agrees.value_counts()) for title, t in built.items()}
     print(json_text({"markdown": str(paths["md"]), "latex": str(paths["tex"]),
@@ -664,6 +664,8 @@ def build_parser() -> argparse.ArgumentParser:
     report = sub.add_parser("report", help="figures, tables and report.md of a study already run")
     report.add_argument("study", help="study definition (TOML)")
     report.add_argument("--results", default="results", help="results root (default results/)")
+    report.add_argument("--jobs", type=_number(1, 256, integer=True), default=2,
+                        help="processes drawing the figures (default 2)")
     report.set_defaults(func=_cmd_report)
 
     compare = sub.add_parser("compare", help="a measurement file against the matching simulation")
@@ -716,6 +718,8 @@ def build_parser() -> argparse.ArgumentParser:
     tab = isub.add_parser("tables", help="Tables 3-6 and Appendix B from their raw inputs")
     tab.add_argument("--out", default="results/identify", help="output folder")
     tab.add_argument("--no-table6", action="store_true", help="skip Table 6's fits (~40 s)")
+    tab.add_argument("--jobs", type=_number(1, 256, integer=True), default=2,
+                     help="processes running Table 6's fits (default 2)")
     tab.set_defaults(func=_cmd_identify_tables)
     dec = isub.add_parser("decrement", help="Td, zeta, omega_n (and EI, E) from two peaks")
     for name, kind_, text in (("x1", float, "first peak"), ("xn", float, "n-th peak"),

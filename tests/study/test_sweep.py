@@ -248,6 +248,20 @@ def test_report_figures_and_tables_of_a_grid(small_run):
     assert all(len(s) == round(0.2 * f) + 1 for s, f in zip(table.tip_poincare, table.axis_freq_hz))
 
 
+def test_report_drawn_by_two_processes_is_the_serial_one(small_run, tmp_path):
+    """jobs=2 draws the same figures and writes the same report.md, in the same order."""
+    import shutil
+
+    study, root, _ = small_run
+    serial = make_report(study, root / "res1").read_text()
+    shutil.copytree(root / "res1" / "small", tmp_path / "small",
+                    ignore=shutil.ignore_patterns("figures", "report.md"))
+    parallel = make_report(study, tmp_path, jobs=2).read_text()
+    assert parallel == serial
+    assert sorted(p.name for p in (tmp_path / "small" / "figures").iterdir()) == \
+        sorted(p.name for p in (root / "res1" / "small" / "figures").iterdir())
+
+
 def test_report_of_a_chirp_has_a_spectrogram_and_its_frfs(tmp_path):
     text = """
 [study]

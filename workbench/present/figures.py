@@ -26,6 +26,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
@@ -121,22 +122,28 @@ def regime_shares(table: pd.DataFrame):
     """Stacked bars of the contact-code time shares per drive frequency, a panel per rest."""
     parts = panels(table, ("freq_hz",))
     fig, axes = _grid(len(parts), sharey=True)
+    shown = set()
     for ax, (title, part) in zip(axes, parts):
         part = _ok(part).sort_values("axis_freq_hz")
         x = np.arange(len(part))
         bottom = np.zeros(len(part))
         for code in CONTACT_CODES:
             share = part[f"share_{code}"].to_numpy()
-            ax.bar(x, share, bottom=bottom, color=CODE_COLORS[code], width=0.8, label=str(code))
+            if not np.any(share > 0):        # no bars of zero height to draw
+                continue
+            ax.bar(x, share, bottom=bottom, color=CODE_COLORS[code], width=0.8)
             bottom += share
+            shown.add(code)
         ax.set_xticks(x, [f"{f:g}{'' if s else '*'}" for f, s in
                           zip(part.axis_freq_hz, part.steady.astype(bool))], fontsize=7)
         ax.set_ylim(0, 1)
         ax.set_title(title, fontsize=9)
         ax.set_xlabel(label("freq_hz") + " (*: not steady)")
         ax.set_ylabel("time share")
-    axes[-1].legend(title="contact", fontsize=7, title_fontsize=7, bbox_to_anchor=(1.02, 1),
-                    loc="upper left")
+    handles = [matplotlib.patches.Patch(color=CODE_COLORS[c], label=str(c))
+               for c in CONTACT_CODES if c in shown]
+    axes[-1].legend(handles=handles, title="contact", fontsize=7, title_fontsize=7,
+                    bbox_to_anchor=(1.02, 1), loc="upper left")
     return fig
 
 
@@ -235,8 +242,9 @@ def spectrogram(signals: pd.DataFrame, title: str, channel: str = "strain1",
     keep = f <= fmax
     fig, ax = plt.subplots(figsize=(8, 4))
     db = 10 * np.log10(sxx[keep] + 1e-300)
+    # rasterized: the PDF holds the mesh as one image, not a path per cell
     im = ax.pcolormesh((t[0] + tt) / 60.0, f[keep], db, shading="auto", cmap="jet",
-                       vmin=db.max() - 80, vmax=db.max())
+                       vmin=db.max() - 80, vmax=db.max(), rasterized=True)
     fig.colorbar(im, ax=ax, label=f"{channel} PSD (dB re 1/Hz)")
     ax.set_xlabel("time (min)")
     ax.set_ylabel("frequency (Hz)")

@@ -16,7 +16,6 @@ in ``tables/frf_peaks.{csv,md}``.
 """
 from __future__ import annotations
 
-import itertools
 import json
 import time
 from pathlib import Path
@@ -54,47 +53,77 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     return figs
 
 
-def _series_figures(study: Study, table: pd.DataFrame, out: Path, frf_peaks: list):
-    """(name, figure builder) per saved series, one point's series in memory at a time;
-    the FRF peaks of a chirp's series are added to ``frf_peaks``."""
-    for _, row in table.iterrows():
-        path = out / "series" / f"{row.key}.parquet"
-        if not path.exists():
-            continue
-        sig = pd.read_parquet(path)
-        ev = pd.read_parquet(path.with_suffix(".events.parquet"))
-        t_end = float(sig.index[-1])
-        title = point_title(row)
-        if row.direction:
-            title += f", {row.direction} sweep"
-        if row.status != "ok":                     # what was computed before the failure
-            title += f" — {row.status} at t = {t_end:.2f} s"
-        tag = row.key[:8]
-        short = min(0.5, study.window_s)
-        yield f"time_history_{tag}", lambda: F.time_history(sig, row.static_tip_y, title, short)
-        yield f"strain_spectra_{tag}", lambda: F.strain_spectra(sig, title, study.window_s)
-        yield f"switching_{tag}", lambda: F.switching_diagram(ev, t_end, title, short)
-        if drives.DRIVES[study.excitation["kind"]].swept:
-            yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
-            responses = [c for c in sig.columns if c in RESPONSES]
-            f_lo, f_hi = drives.band_hz(study.excitation)
-            tables = {title: frf(sig, responses, segment_s=segment_for(sig))}
-            frf_peaks.append(peak_table(tables, responses, f_lo, f_hi))
-            yield f"frf_{tag}", lambda: F.frf_figure(tables[title], responses,
-                                                     f"{title}: H1, H2, coherence against force1",
-                                                     f_max=1.2 * f_hi)
+def _series_figures(study: Study, row, out: Path, frf_peaks: list):
+    """(name, figure builder) of one point's saved series (none if it has no series);
+    a chirp's FRF peaks are added to ``frf_peaks``."""
+    path = out / "series" / f"{row.key}.parquet"
+    if not path.exists():
+        return
+    sig = pd.read_parquet(path)
+    ev = pd.read_parquet(path.with_suffix(".events.parquet"))
+    t_end = float(sig.index[-1])
+    title = point_title(row)
+    if row.direction:
+        title += f", {row.direction} sweep"
+    if row.status != "ok":                     # what was computed before the failure
+        title += f" — {row.status} at t = {t_end:.2f} s"
+    tag = row.key[:8]
+    short = min(0.5, study.window_s)
+    yield f"time_history_{tag}", lambda: F.time_history(sig, row.static_tip_y, title, short)
+    yield f"strain_spectra_{tag}", lambda: F.strain_spectra(sig, title, study.window_s)
+    yield f"switching_{tag}", lambda: F.switching_diagram(ev, t_end, title, short)
+    if drives.DRIVES[study.excitation["kind"]].swept:
+        yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
+        responses = [c for c in sig.columns if c in RESPONSES]
+        f_lo, f_hi = drives.band_hz(study.excitation)
+        tables = {title: frf(sig, responses, segment_s=segment_for(sig))}
+        frf_peaks.append(peak_table(tables, responses, f_lo, f_hi))
+        yield f"frf_{tag}", lambda: F.frf_figure(tables[title], responses,
+                                                 f"{title}: H1, H2, coherence against force1",
+                                                 f_max=1.2 * f_hi)
 
 
-def make_report(study: Study, results: str | Path = "results") -> Path:
-    """Write figures, tables, report.md and provenance.json for a study already run."""
+#: Relative cost of drawing a grid figure (a series unit is 1): the order of the tasks.
+_DRAW_COST = {"regime_shares": 4.0, "bifurcation": 3.0}
+
+
+def _draw(study: Study, table: pd.DataFrame, out: Path, unit) -> tuple[dict, list]:
+    """Draw and save one unit of the report: a grid figure (its name) or the
+    figures of one point's series (its row number).  Returns the figures
+    made {name: paths} and the FRF peak tables."""
+    frf_peaks: list = []
+    if isinstance(unit, str):
+        builders = [(unit, _grid_figures(study, table)[unit])]
+    else:
+        builders = _series_figures(study, table.iloc[unit], out, frf_peaks)
+    made = {name: F.save(build(), out / "figures" / name) for name, build in builders}
+    return made, frf_peaks
+
+
+def make_report(study: Study, results: str | Path = "results", jobs: int = 1) -> Path:
+    """Write figures, tables, report.md and provenance.json for a study already run.
+
+    The figures are drawn by ``jobs`` processes (joblib), a grid figure or
+    one point's series per task.
+    """
     out = Path(results) / study.name
     table = pd.read_parquet(out / "points.parquet")
     t0 = time.perf_counter()
-    made, frf_peaks = {}, []
-    builders = itertools.chain(_grid_figures(study, table).items(),
-                               _series_figures(study, table, out, frf_peaks))
-    for name, build in builders:
-        made[name] = F.save(build(), out / "figures" / name)
+    units = list(_grid_figures(study, table)) + [
+        i for i, key in enumerate(table.key) if (out / "series" / f"{key}.parquet").exists()]
+    if jobs > 1 and len(units) > 1:
+        from joblib import Parallel, delayed
+        # the costliest first (a chirp's series, the many-panel grid figures), so
+        # that the processes finish together; the report keeps the units' order
+        order = sorted(range(len(units)), key=lambda i: -_DRAW_COST.get(units[i], 1.0))
+        done = Parallel(n_jobs=jobs)(delayed(_draw)(study, table, out, units[i]) for i in order)
+        drawn = [None] * len(units)
+        for i, result in zip(order, done):
+            drawn[i] = result
+    else:
+        drawn = [_draw(study, table, out, u) for u in units]
+    made = {name: paths for figures, _ in drawn for name, paths in figures.items()}
+    frf_peaks = [peaks for _, found in drawn for peaks in found]
     tables = write_tables(table, out / "tables")
     if frf_peaks:
         tables += write_frf_peaks(pd.concat(frf_peaks, ignore_index=True), out / "tables")
