@@ -16,7 +16,6 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-import scipy.linalg
 
 from . import packing as mdl
 from ..core import layout as ly
@@ -52,12 +51,14 @@ def _to_hz(lam: np.ndarray) -> np.ndarray:
 
 def natural_frequencies(p: Parameters, joint: str = "locked") -> np.ndarray:
     """Natural frequencies (Hz), ascending; rigid-body modes give exactly 0."""
+    import scipy.linalg         # here, not at import: a run needs only linear_eigenvalues
     M, K, _ = linear_matrices(p, joint)
     return _to_hz(scipy.linalg.eigh(K, M, eigvals_only=True))
 
 
 def mode_shapes(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Frequencies (Hz), mass-normalised mode shapes (columns) and coordinate names."""
+    import scipy.linalg
     M, K, names = linear_matrices(p, joint)
     lam, vec = scipy.linalg.eigh(K, M)
     return _to_hz(lam), vec, names
