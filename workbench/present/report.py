@@ -113,8 +113,8 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
         i for i, key in enumerate(table.key) if (out / "series" / f"{key}.parquet").exists()]
     if jobs > 1 and len(units) > 1:
         from joblib import Parallel, delayed
-        # the costliest first (a chirp's series, the many-panel grid figures), so
-        # that the processes finish together; the report keeps the units' order
+        # the many-panel grid figures first, so that the processes finish
+        # together; the report keeps the units' order
         order = sorted(range(len(units)), key=lambda i: -_DRAW_COST.get(units[i], 1.0))
         done = Parallel(n_jobs=jobs)(delayed(_draw)(study, table, out, units[i]) for i in order)
         drawn = [None] * len(units)
