@@ -470,6 +470,11 @@ def _add_record_options(parser) -> None:
     _add_format_option(parser)
 
 
+def _add_jobs_option(parser, what: str) -> None:
+    parser.add_argument("--jobs", type=_number(1, 256, integer=True), default=2,
+                        help=f"{what} (default 2)")
+
+
 def _add_format_option(parser, option="--format", dest="format", what="the file's format") -> None:
     from .experiments.files import FORMATS
     parser.add_argument(option, dest=dest, choices=tuple(FORMATS),
@@ -649,7 +654,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sweep = sub.add_parser("sweep", help="run a study's grid (TOML) in parallel, resumably")
     sweep.add_argument("study", help="study definition, e.g. studies/default.toml")
-    sweep.add_argument("--jobs", type=_number(1, 256, integer=True), default=2, help="worker processes (default 2)")
+    _add_jobs_option(sweep, "worker processes")
     sweep.add_argument("--scheduler", default=None,
                        help="Dask scheduler address (tcp://host:port): run on that cluster")
     sweep.add_argument("--fresh", action="store_true", help="discard finished points first")
@@ -664,8 +669,7 @@ def build_parser() -> argparse.ArgumentParser:
     report = sub.add_parser("report", help="figures, tables and report.md of a study already run")
     report.add_argument("study", help="study definition (TOML)")
     report.add_argument("--results", default="results", help="results root (default results/)")
-    report.add_argument("--jobs", type=_number(1, 256, integer=True), default=2,
-                        help="processes drawing the figures (default 2)")
+    _add_jobs_option(report, "processes drawing the figures")
     report.set_defaults(func=_cmd_report)
 
     compare = sub.add_parser("compare", help="a measurement file against the matching simulation")
@@ -708,7 +712,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="a parameter to fit and its start (CGS; force_n in N), repeatable; "
                           "fittable: e_a, e_b, zeta_a, zeta_b, mu, cork_k, cork_c, force_n")
     _add_record_options(est)
-    est.add_argument("--jobs", type=_number(1, 256, integer=True), default=2, help="worker processes (default 2)")
+    _add_jobs_option(est, "worker processes")
     est.add_argument("--max-nfev", type=_number(1, 100000, integer=True), default=30, help="most residual evaluations")
     est.add_argument("--out", metavar="FILE.csv", help="write the fitted values")
     est.set_defaults(func=_cmd_estimate)
@@ -718,8 +722,7 @@ def build_parser() -> argparse.ArgumentParser:
     tab = isub.add_parser("tables", help="Tables 3-6 and Appendix B from their raw inputs")
     tab.add_argument("--out", default="results/identify", help="output folder")
     tab.add_argument("--no-table6", action="store_true", help="skip Table 6's fits (~40 s)")
-    tab.add_argument("--jobs", type=_number(1, 256, integer=True), default=2,
-                     help="processes running Table 6's fits (default 2)")
+    _add_jobs_option(tab, "processes running Table 6's fits")
     tab.set_defaults(func=_cmd_identify_tables)
     dec = isub.add_parser("decrement", help="Td, zeta, omega_n (and EI, E) from two peaks")
     for name, kind_, text in (("x1", float, "first peak"), ("xn", float, "n-th peak"),
