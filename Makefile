@@ -25,11 +25,12 @@ setup: $(STAMP)  ## create .venv and install the package (editable) with dev ext
 test: $(STAMP)  ## run the test suite (physics checks included)
 	$(PY) -m pytest -q
 
-# About 20 minutes: the paper's method (LSODA) runs on windows, the default grid twice.
-bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md
+# About 20 minutes: a cold compile, LSODA on windows, the default grid twice, `make study`.
+bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md and README.md
 	$(PY) -m pytest -q benchmarks --benchmark-only --benchmark-enable --benchmark-autosave \
 		--benchmark-columns=min,median,max,rounds -p no:randomly
-	$(PY) benchmarks/summarise.py --out benchmarks/results.md --readme docs/performance.md
+	$(PY) benchmarks/summarise.py --out benchmarks/results.md --readme docs/performance.md \
+		--targets README.md
 
 # The studies of `make study` (studies/<name>.toml -> results/<name>/report.md).
 STUDIES := free_decay stepped chirp shaker

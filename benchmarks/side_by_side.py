@@ -1,14 +1,21 @@
-"""The workbench against the paper's method on the same windows of the same runs.
+"""The benchmark cases of ``make bench`` and the solvers compared on them.
 
-The reference (:mod:`workbench.reference`: the same equations in NumPy,
-LSODA, restarts at every event) costs milliseconds per right-hand side, so
-it cannot cover the whole 10 s sine run (about 45 minutes) or the 240 s
-chirp in a benchmark.  It is run on *windows* of them: a short span that
-starts from the state and regime the workbench reached at that time, clear
-of events.  The workbench's own cost is that of the whole run,
-per simulated second; the ratio compares seconds of wall time per
-simulated second.  The kernel's accuracy is measured on the same windows
-(:func:`kernel_window`), against a converged kernel run at a tiny step.
+The cases are the targets' runs at the default settings (1.016 mm gap,
+20 Hz, 200 N, cubic cork): the 10 s sine with and without the tip mass, and
+the 240 s chirp (5-65 Hz, tip mass).  Accuracy against cost is measured on
+a 0.25 s *window* of each sine, a span that starts from the state and
+regime the kernel reached there, clear of events, so that slow solvers can
+be run on it:
+
+* :func:`kernel_window`: the kernel (RK4, events bracketed) at a given step;
+* :func:`lsoda_window`: what a user would build instead, the kernel's own
+  compiled model under scipy's LSODA with events and restarts
+  (``lsoda_side_by_side.CompiledLSODA``);
+* :func:`jet_window`: the slow NumPy reference of the same equations
+  (:mod:`workbench.reference`, LSODA, the paper's method).
+
+Errors are against a converged kernel run on the same window (RK4 at
+CONVERGED_DT, its own error against half that step reported beside it).
 """
 from __future__ import annotations
 
@@ -18,13 +25,14 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from lsoda_side_by_side import CompiledLSODA
 from workbench.core import layout as ly
-from workbench.model.excitation import chirp, sine
-from workbench.study.metrics import contact_shares
+from workbench.model.excitation import DEFAULT_FORCE_N, chirp, sine
 from workbench.model.params import Parameters
 from workbench.model.regimes import is_stick, set_of
-from workbench.reference import HybridReference, Regime, shaker
 from workbench.model.simulate import simulate
+from workbench.reference import HybridReference, Regime, shaker
+from workbench.study.metrics import contact_shares
 
 #: Sample rate of the windows' tip height (Hz).
 SAMPLE_HZ = 1000.0
@@ -34,18 +42,19 @@ CONVERGED_DT = 3.125e-6
 
 @dataclass(frozen=True)
 class Case:
-    """A benchmark run: 1.016 mm gap, tip mass, cubic cork."""
+    """A benchmark run: 1.016 mm gap, cubic cork, the default force."""
 
     name: str
-    force_n: float
     duration_s: float
-    window_at_s: float         # the window starts at the first free-flight sample after this
-    window_s: float
+    tip_mass: bool = True
     chirp: bool = False
+    force_n: float = DEFAULT_FORCE_N
+    window_at_s: float = 5.0   # the window starts at the first sample clear of events after this
+    window_s: float = 0.25
 
     @property
     def params(self) -> Parameters:
-        return Parameters().replace(gap_mm=1.016, tip_mass=True, cork="cubic")
+        return Parameters().replace(gap_mm=1.016, tip_mass=self.tip_mass, cork="cubic")
 
     @property
     def excitation(self) -> np.ndarray:
@@ -54,10 +63,10 @@ class Case:
         return sine(self.force_n, 20.0, ramp_s=1.0)
 
 
-#: The benchmark run: 20 N, 20 Hz, 10 s.
-SINE = Case("sine 10 s", 20.0, 10.0, window_at_s=5.0, window_s=0.25)
-#: The chirp: 10 N, 5-65 Hz over 240 s (seed §5.5).
-CHIRP = Case("chirp 240 s", 10.0, 240.0, window_at_s=120.0, window_s=0.25, chirp=True)
+SINE_TIP = Case("sine 10 s, tip mass", 10.0)
+SINE_NO_TIP = Case("sine 10 s, no tip mass", 10.0, tip_mass=False)
+CHIRP = Case("chirp 240 s, tip mass", 240.0, chirp=True)
+CASES = {"sine-tip": SINE_TIP, "sine-no-tip": SINE_NO_TIP, "chirp": CHIRP}
 
 
 def full_run(case: Case, dt: float | None = None):
@@ -65,7 +74,7 @@ def full_run(case: Case, dt: float | None = None):
     return simulate(case.params, case.excitation, case.duration_s, dt=dt, output_hz=SAMPLE_HZ)
 
 
-#: A window must hold at least this many of the workbench's events.
+#: A window must hold at least this many of the kernel's events.
 MIN_WINDOW_EVENTS = 4
 
 
@@ -93,23 +102,31 @@ class Window:
     wall_s: float
     t: np.ndarray
     tip_y: np.ndarray
-    shares: dict
+    shares: dict               # contact code (text) -> fraction of the window
     n_events: int
     nfev: int = 0
 
     def errors(self, converged: "Window") -> dict:
-        """Tip-height error relative to the converged tip's range, and the largest
-        contact-share difference (fraction of the window's time)."""
-        n = min(len(self.tip_y), len(converged.tip_y))
-        span = np.ptp(converged.tip_y[:n])
-        tip = float(np.max(np.abs(self.tip_y[:n] - converged.tip_y[:n])) / span)
+        """Tip-height error relative to the converged tip's range (at the samples both
+        hold), and the largest contact-share difference (fraction of the window)."""
+        mine = np.rint(self.t * SAMPLE_HZ).astype(np.int64)
+        theirs = np.rint(converged.t * SAMPLE_HZ).astype(np.int64)
+        _, i, j = np.intersect1d(mine, theirs, return_indices=True)
+        if len(i) < 2:
+            raise RuntimeError(f"{self.solver} and the converged run share no samples")
+        span = np.ptp(converged.tip_y[j])
+        tip = float(np.max(np.abs(self.tip_y[i] - converged.tip_y[j])) / span)
         codes = set(self.shares) | set(converged.shares)
         share = max(abs(self.shares.get(c, 0.0) - converged.shares.get(c, 0.0)) for c in codes)
         return {"tip_error_rel": tip, "share_error": float(share)}
 
 
+def _samples(case: Case, t0: float) -> np.ndarray:
+    return t0 + np.arange(round(case.window_s * SAMPLE_HZ) + 1) / SAMPLE_HZ
+
+
 def kernel_window(case: Case, t0: float, y0: np.ndarray, regime: int, dt: float) -> Window:
-    """The workbench over the window from (t0, y0) in ``regime`` at step dt."""
+    """The kernel over the window from (t0, y0) in ``regime`` at step dt."""
     start = time.perf_counter()
     run = simulate(case.params, case.excitation, case.window_s, dt=dt, output_hz=SAMPLE_HZ,
                    initial=y0, t0=t0, regime=regime)
@@ -120,19 +137,28 @@ def kernel_window(case: Case, t0: float, y0: np.ndarray, regime: int, dt: float)
                   run.signals.tip_y.to_numpy(), run.contact_time_share(), len(run.events) - 1)
 
 
-def reference_window(case: Case, t0: float, y0: np.ndarray, regime: int, rtol: float,
-                     method: str = "LSODA") -> Window:
-    """The paper's method over the window from (t0, y0) in ``regime``: atol = rtol / 100."""
-    ref = HybridReference(case.params, excitation=shaker(case.excitation), rtol=rtol,
-                          atol=rtol * 1e-2, method=method)
-    n = round(case.window_s * SAMPLE_HZ)
-    t_eval = t0 + np.arange(n + 1) / SAMPLE_HZ
+def lsoda_window(case: Case, t0: float, y0: np.ndarray, regime: int, rtol: float) -> Window:
+    """The kernel's compiled model under scipy's LSODA (events, restarts) over the window."""
+    solver = CompiledLSODA(case.params, case.excitation)
     start = time.perf_counter()
-    start_regime = Regime(set_of(regime), is_stick(regime))
-    out = ref.run(t0, t0 + case.window_s, y0, start_regime, max_events=10**6, t_eval=t_eval)
+    t, tip, shares, n_events = solver.run(t0, t0 + case.window_s, y0, regime, rtol,
+                                          _samples(case, t0)[1:])
+    wall = time.perf_counter() - start
+    return Window("compiled model, LSODA", rtol, wall, t, tip,
+                  {str(k): v for k, v in shares.items()}, n_events, solver.nfev)
+
+
+def jet_window(case: Case, t0: float, y0: np.ndarray, regime: int, rtol: float) -> Window:
+    """The NumPy reference under LSODA (the paper's method) over the window: atol = rtol / 100."""
+    ref = HybridReference(case.params, excitation=shaker(case.excitation), rtol=rtol,
+                          atol=rtol * 1e-2, method="LSODA")
+    start = time.perf_counter()
+    out = ref.run(t0, t0 + case.window_s, y0, Regime(set_of(regime), is_stick(regime)),
+                  max_events=10**6, t_eval=_samples(case, t0))
     wall = time.perf_counter() - start
     tip = np.array([ref.model.tip_y(y[:ly.N_DOF]) for y in out.samples])
     events = {"t": [t0] + [e["t"] for e in out.log],
               "to_regime": [regime] + [e["to_regime"] for e in out.log]}
     shares = contact_shares(pd.DataFrame(events), t0, t0 + case.window_s)
-    return Window(f"reference {method}", rtol, wall, out.t, tip, shares, len(out.log), out.nfev)
+    return Window("NumPy reference, LSODA", rtol, wall, np.asarray(out.t), tip, shares,
+                  len(out.log), out.nfev)

@@ -6,20 +6,18 @@
   of :func:`~workbench.core.constrained.rhs_regime` in free flight, single
   contact and double contact, sticking and sliding;
 * a 10 s free-flight run at dt = 5e-5 s (joint locked: without contact the
-  loose body would fly through the plates), 200 000 RK4 steps;
-* the benchmark run: 10 s sine, 1.016 mm gap, 20 Hz, cubic cork, with and
-  without the tip mass, at the default step and the default force, with
-  contact and events.
+  loose body would fly through the plates), 200 000 RK4 steps.
+
+The runs with contact and events are in test_bench_runs.py.
 """
 import numpy as np
 import pytest
 
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
-from workbench.model.excitation import DEFAULT_FORCE_N, sine
+from workbench.model.excitation import sine
 from workbench.model.freeflight import integrate
 from workbench.model.params import Parameters
-from workbench.model.simulate import simulate
 
 from rhs_parts import RHS, RHS_REGIME, repeat
 
@@ -69,16 +67,3 @@ def test_free_flight_10s(benchmark):
     tr = benchmark.pedantic(integrate, args=(model, mdl.state(), 10.0, 5e-5, 20, ex),
                             rounds=3, iterations=1)
     assert tr.status == 0 and len(tr.t) == 10001
-
-
-@pytest.mark.parametrize("tip", [True, False], ids=["tip", "no-tip"])
-def test_contact_sine_10s(benchmark, tip):
-    p = Parameters().replace(gap_mm=1.016, tip_mass=tip, cork="cubic")
-    ex = sine(DEFAULT_FORCE_N, 20.0, ramp_s=1.0)
-    simulate(p, ex, 0.01)                                  # compile / load cache
-    run = benchmark.pedantic(simulate, args=(p, ex, 10.0), rounds=3, iterations=1)
-    s = run.summary()
-    benchmark.extra_info.update({k: s[k] for k in ("n_events", "n_impacts", "dt",
-                                                   "energy_balance_rel", "max_penetration_cm")})
-    benchmark.extra_info["tip_mass"] = tip
-    assert run.ok

@@ -2,24 +2,29 @@
 
 * scaling: the default study's grid (studies/shaker.toml: 240 points, 4 gaps
   x 10 frequencies x tip mass on/off x 3 cork models) with 1 and 2 worker
-  processes, side by side in one run; each point simulates 2 s instead of
-  10 s so that the pair takes minutes, not most of an hour.  The speed-up
+  processes, side by side in one run; each point simulates 1 s instead of
+  10 s so that the pair takes minutes.  The speed-up
   is the ratio of the two wall times;
-* the whole default study (10 s per point) only when WORKBENCH_BENCH_FULL=1;
-  ``make study`` records the same wall time in results/shaker/runs.json.
+* ``make study`` whole, warm cache, into an empty results folder: every
+  study of the Makefile's STUDIES, the modes, the identification tables
+  and the estimator, figures and reports included.
 """
 import dataclasses
 import os
 import shutil
+import subprocess
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from workbench.study import definition as S
 from workbench.study.sweep import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
-SCALING_DURATION_S = 2.0
+SCALING_DURATION_S = 1.0
+#: The sweep studies of ``make study`` (the Makefile's STUDIES).
+STUDIES = ("free_decay", "stepped", "chirp", "shaker")
 
 
 def _fresh_run(study, results, jobs):
@@ -48,10 +53,19 @@ def test_sweep_scaling(benchmark, tmp_path, default_grid, jobs):
     assert len(table) == len(default_grid.points)
 
 
-@pytest.mark.skipif(os.environ.get("WORKBENCH_BENCH_FULL") != "1",
-                    reason="the whole default study: set WORKBENCH_BENCH_FULL=1")
-def test_default_study(benchmark, tmp_path):
-    study = S.load(ROOT / "studies" / "shaker.toml")
-    table = benchmark.pedantic(_fresh_run, args=(study, tmp_path / "res", 2), rounds=1,
-                               iterations=1)
-    benchmark.extra_info.update({"points": len(table), "cpu_s": float(table.wall_s.sum())})
+def _make_study(results):
+    shutil.rmtree(results, ignore_errors=True)
+    env = {k: v for k, v in os.environ.items() if not k.startswith("MAKE")}
+    subprocess.run(["make", "-s", "study", f"RESULTS={results}"], cwd=ROOT, env=env, check=True,
+                   stdout=subprocess.DEVNULL)
+
+
+def test_make_study(benchmark, tmp_path):
+    """``make study`` whole (every study, figure and table) into an empty folder."""
+    results = tmp_path / "results"
+    benchmark.pedantic(_make_study, args=(results,), rounds=1, iterations=1)
+    tables = [pd.read_parquet(results / name / "points.parquet") for name in STUDIES]
+    benchmark.extra_info.update({"points": int(sum(len(t) for t in tables)),
+                                 "failed": int(sum((t.status != "ok").sum() for t in tables)),
+                                 "cpu_s": float(sum(t.wall_s.sum() for t in tables))})
+    assert (results / "index.md").exists()
