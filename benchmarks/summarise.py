@@ -231,8 +231,11 @@ def summary(paths: list[Path]) -> str:
     return "\n".join(parts)
 
 
-_TABLE_PREFIXES = {"Cost": ("test_rhs",), "Whole": ("test_whole_run",),
-                   "Accuracy": ("test_accuracy",), "A": ("test_workbench_run",),
+_TABLE_PREFIXES = {"Cost": ("test_rhs",),
+                   "Whole": tuple(f"test_whole_run[{key}]" for key in WHOLE_CASES),
+                   "Accuracy": tuple(f"test_accuracy_{solver}[{key}-" for key in WINDOW_CASES
+                                     for solver in ("kernel", "lsoda")),
+                   "A": ("test_workbench_run",),
                    "Sweeps": ("test_sweep_scaling", "test_make_study")}
 
 
