@@ -417,17 +417,12 @@ def project(y, P, free, cg, cw, rg):
     coordinates moves the open gaps too: an open point that this correction
     alone would carry past its impact event (g + rg[RG_ARM] from >= 0 to
     < 0) is held at g = 0 with the active ones, so that a projection never
-    creates a penetration.  An open point already past its event (a point
-    just released at the located event, a little below contact) is held
-    at g = 0 as well: the correction would otherwise carry it deeper, and
-    its event is armed at the depth it is left at (transitions.arm_gaps).
-    Velocities: the active rows' rates (normal, and tangential when
-    sticking) to zero.  Only free joint coordinates move.
+    creates a penetration.  Velocities: the active rows' rates (normal, and
+    tangential when sticking) to zero.  Only free joint coordinates move.
 
-    Returns ``(correction, drift)`` (cm): the largest |g| of the active (and
-    released) gaps before the projection (the step's truncation error on
-    the constraint) and of the active gaps after it (what the solution
-    keeps).
+    Returns ``(correction, drift)`` (cm): the largest |g| of the active gaps
+    before the projection (the step's truncation error on the constraint)
+    and after it (what the solution keeps).
     """
     set_index = int(rg[ly.RG_SET])
     if set_index == 0:
@@ -436,19 +431,15 @@ def project(y, P, free, cg, cw, rg):
     fill_geometry(y, P, cg)
     stick = rg[ly.RG_STICK] != 0.0
     armed = 0
-    released = 0            # open and past its event: released below contact
     for p in range(ly.N_POINTS):
-        if not in_set(set_index, p):
-            if cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] >= 0.0:
-                armed |= 1 << p
-            else:
-                released |= 1 << p
-    correction = _project_gaps(y, set_index, stick, n_normal, released, P, free, cg, cw)
-    held = released
+        if not in_set(set_index, p) and cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] >= 0.0:
+            armed |= 1 << p
+    correction = _project_gaps(y, set_index, stick, n_normal, 0, P, free, cg, cw)
+    held = 0
     for p in range(ly.N_POINTS):
         if armed & (1 << p) and cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] < 0.0:
             held |= 1 << p
-    if held != released:
+    if held != 0:
         _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw)
     drift = 0.0
     for r in range(n_normal):
