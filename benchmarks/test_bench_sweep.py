@@ -11,6 +11,7 @@
 """
 import dataclasses
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -23,8 +24,8 @@ from workbench.study.sweep import run_study
 
 ROOT = Path(__file__).resolve().parents[1]
 SCALING_DURATION_S = 1.0
-#: The sweep studies of ``make study`` (the Makefile's STUDIES).
-STUDIES = ("free_decay", "stepped", "chirp", "shaker")
+#: The sweep studies of ``make study``: the Makefile's STUDIES.
+STUDIES = re.search(r"^STUDIES := (.+)$", (ROOT / "Makefile").read_text(), re.M).group(1).split()
 
 
 def _fresh_run(study, results, jobs):
