@@ -211,6 +211,23 @@ def test_paper_start_run_is_consistent(paper_start_run):
     assert regime_name(13) == "stick {2,3}" and regime_name(0) == "free"
 
 
+def test_a_point_released_by_the_regime_choice_leaves_from_contact():
+    """The stress study's deepest penetration (1.016 mm, 45 Hz, tip mass, quadratic cork, 200 N).
+
+    At 2.098799 s an accumulation impact of point 1, with point 3 closed,
+    leaves contact {3}.  The projection onto {3} used to carry the released
+    point 1 from about -1e-9 to -9.06e-9 cm, its impact event was armed at
+    that depth, and its next closing, 1.8e-4 s later, penetrated 9.06e-9 cm.
+    Held at g = 0 when the regime is chosen, it leaves from contact, and a
+    closing is found within about the event-time tolerance times its speed
+    (113 cm/s x 1e-11 s) of GAP_EPS.
+    """
+    p = Parameters(cork="quadratic").replace(gap_mm=1.016)
+    run = simulate(p, X.sine(200.0, 45.0, ramp_s=1.0), 2.2)
+    assert run.ok, run.message
+    assert run.stats["max_penetration_cm"] < 3e-9
+
+
 def test_energy_balance_closes_at_a_fine_step():
     run = simulate(Parameters(), X.sine(50.0, 20.0, ramp_s=0.05), 0.15, dt=5e-6,
                    initial="paper")

@@ -409,7 +409,7 @@ def _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw):
 
 
 @nb.njit(**JIT)
-def project(y, P, free, cg, cw, rg):
+def project(y, P, free, cg, cw, rg, hold_open_below=False):
     """Pull the state onto the active constraints of the regime in rg.
 
     Positions: two Newton steps onto the active gaps g = 0 (the gaps are
@@ -417,8 +417,12 @@ def project(y, P, free, cg, cw, rg):
     coordinates moves the open gaps too: an open point that this correction
     alone would carry past its impact event (g + rg[RG_ARM] from >= 0 to
     < 0) is held at g = 0 with the active ones, so that a projection never
-    creates a penetration.  Velocities: the active rows' rates (normal, and
-    tangential when sticking) to zero.  Only free joint coordinates move.
+    creates a penetration.  With ``hold_open_below`` (a regime just chosen)
+    every open point left below g = 0 is held at g = 0 as well: a point the
+    new regime releases leaves from contact, not from the depth to which
+    the projection onto the remaining contact carried it.  Velocities: the
+    active rows' rates (normal, and tangential when sticking) to zero.
+    Only free joint coordinates move.
 
     Returns ``(correction, drift)`` (cm): the largest |g| of the active gaps
     before the projection (the step's truncation error on the constraint)
@@ -437,7 +441,10 @@ def project(y, P, free, cg, cw, rg):
     correction = _project_gaps(y, set_index, stick, n_normal, 0, P, free, cg, cw)
     held = 0
     for p in range(ly.N_POINTS):
-        if armed & (1 << p) and cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] < 0.0:
+        if in_set(set_index, p):
+            continue
+        g = cg[ly.CG_G + p, ly.CG_VAL]
+        if (armed & (1 << p) and g + rg[ly.RG_ARM + p] < 0.0) or (hold_open_below and g < 0.0):
             held |= 1 << p
     if held != 0:
         _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw)

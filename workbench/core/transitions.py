@@ -381,7 +381,7 @@ def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
         st[ly.ST_N_INCONSISTENT] += 1.0
         st[ly.ST_E_INCONSISTENT] += lost
         st[ly.ST_E_IMPACT] += lost
-    project(y, P, free, cg, cw, rg)
+    project(y, P, free, cg, cw, rg, True)
     arm_gaps(y, P, cg, rg)
     return rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot)
 
