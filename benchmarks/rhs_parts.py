@@ -27,7 +27,10 @@ PARTS = ("mass matrix, h, gravity", "applied forces", "Cholesky of M", "rhs (fre
 RHS, RHS_REGIME = 3, 4              # the indices of the whole right-hand sides in PARTS
 
 
-@nb.njit(cache=True)
+# Not cached: numba's cache=True checks only this file's timestamp, so a
+# cached loop would keep the machine code of kernels edited since
+# (workbench/core/_cache.py keys only the kernels of workbench.core).
+@nb.njit
 def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
     status = 0
     for i in range(n):
