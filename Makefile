@@ -25,7 +25,7 @@ setup: $(STAMP)  ## create .venv and install the package (editable) with dev ext
 test: $(STAMP)  ## run the test suite (physics checks included)
 	$(PY) -m pytest -q
 
-# About 21 minutes: a cold compile (10), `make study` (7), LSODA on windows, the default grid twice (1 s per point).
+# About 16 minutes idle, 21 beside other work: a cold compile (6-10), `make study` (5-7), LSODA on windows, the default grid twice (1 s per point).
 bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md and README.md
 	$(PY) -m pytest -q benchmarks --benchmark-only --benchmark-enable --benchmark-autosave \
 		--benchmark-columns=min,median,max,rounds -p no:randomly

@@ -6,7 +6,9 @@ Each part runs 100 000 times inside a compiled loop (a Python call would
 time numba's argument unboxing instead), 7 rounds, median per call (µs):
 the mass matrix, h and gravity (``assemble_inertia``), the applied forces,
 the Cholesky factor of M, the whole free-flight ``rhs``, ``rhs_regime`` in
-free flight, single and double contact, and one RK4 step.  The state is a
+free flight, single and double contact, one RK4 step, and what a step adds
+besides its right-hand sides: the projection onto the regime
+(``project``) and the event functions (``event_values``).  The state is a
 random one: the costs do not depend on it.
 """
 import time
@@ -16,14 +18,15 @@ import numpy as np
 
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
-from workbench.core.constrained import rhs_regime
+from workbench.core.constrained import project, rhs_regime
 from workbench.core.dynamics import add_applied_forces, assemble_inertia, factor_free, rhs
+from workbench.core.hybrid import event_values
 from workbench.core.integrate import rk4_step
 from workbench.model.excitation import sine
 from workbench.model.params import Parameters
 
 PARTS = ("mass matrix, h, gravity", "applied forces", "Cholesky of M", "rhs (free flight)",
-         "rhs_regime", "RK4 step")
+         "rhs_regime", "RK4 step", "projection", "event functions")
 RHS, RHS_REGIME = 3, 4              # the indices of the whole right-hand sides in PARTS
 
 
@@ -48,6 +51,10 @@ def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
         elif which == RHS_REGIME:
             status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                                  ydot)
+        elif which == 6:
+            project(y, P, free, cg, cw, rg)
+        elif which == 7:
+            event_values(y, P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
         else:
             status |= rk4_step(1e-3 * i, y, 1e-5, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
                                cw, rg, stages[ly.STAGE_NEXT])
@@ -61,7 +68,7 @@ def main(rounds=7, calls=100_000):
     ydot, ex = np.zeros(ly.N_AUG), sine(1.0, 20.0)
     cases = [(w, (0, False)) for w in range(4)]
     cases += [(4, r) for r in ((0, False), (1, True), (1, False), (5, True), (5, False))]
-    cases += [(5, r) for r in ((0, False), (1, True), (5, True))]
+    cases += [(w, r) for w in (5, 6, 7) for r in ((0, False), (1, True), (5, True))]
     for which, (set_index, stick) in cases:
         work.rg[:] = 0.0
         work.rg[ly.RG_SET], work.rg[ly.RG_STICK], work.rg[ly.RG_SIGN] = set_index, stick, 1.0
@@ -71,7 +78,7 @@ def main(rounds=7, calls=100_000):
             t0 = time.perf_counter()
             repeat(which, calls, y.copy(), *model, ex, *work, ydot)
             times.append((time.perf_counter() - t0) / calls * 1e6)
-        regime = f" (set {set_index}, {'stick' if stick else 'slip'})" if which >= 4 else ""
+        regime = f" (set {set_index}, {'stick' if stick else 'slip'})" if which >= RHS_REGIME else ""
         print(f"{PARTS[which] + regime:40s} {np.median(times):6.2f} us")
 
 
