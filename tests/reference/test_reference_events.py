@@ -74,3 +74,39 @@ def test_reference_drive_agrees_with_the_kernels(ex):
     force = shaker(ex)
     for t in (0.0, 0.13, 0.49, 0.77, 1.5, 120.25, 239.9):
         assert force(t) == pytest.approx(shaker_force(t, ex), rel=1e-12, abs=1e-9)
+
+
+def test_a_failed_event_location_on_lsoda_is_redone_by_radau(monkeypatch):
+    """scipy's brentq on LSODA's dense output can find no sign change (FALLBACK_METHOD's
+    docstring): that segment is integrated again by Radau, and the run goes on."""
+    p = Parameters()
+    kernel = simulate(p, None, 0.024, dt=KERNEL_DT, initial="paper")
+    cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]
+    y0 = kernel.signals[cols].iloc[-1].to_numpy()       # free flight, 1 ms before an impact
+    plain = HybridReference(p).run(0.024, 0.0265, y0)
+    segment = HybridReference._segment
+    failed = []
+
+    def fail_once(self, t, t1, y, reg, evs, asked, method):
+        if method == "LSODA" and not failed:
+            failed.append(t)
+            raise ValueError("f(a) and f(b) must have different signs")
+        return segment(self, t, t1, y, reg, evs, asked, method)
+
+    monkeypatch.setattr(HybridReference, "_segment", fail_once)
+    run = HybridReference(p).run(0.024, 0.0265, y0)
+    assert plain.fallbacks == 0 and run.fallbacks == 1 and failed == [0.024]
+    assert len(plain.log) >= 4
+    assert [(e["kind"], e["to_regime"]) for e in run.log] == \
+           [(e["kind"], e["to_regime"]) for e in plain.log]
+    assert max(abs(a["t"] - b["t"]) for a, b in zip(run.log, plain.log)) < 1e-8
+    assert np.abs(run.y - plain.y)[:ly.N_DOF].max() < 1e-8
+
+
+def test_other_errors_of_a_segment_are_not_retried(monkeypatch):
+    def broken(self, *args):
+        raise ValueError("some other failure")
+
+    monkeypatch.setattr(HybridReference, "_segment", broken)
+    with pytest.raises(ValueError, match="some other failure"):
+        HybridReference(Parameters()).run(0.0, 0.001, np.zeros(2 * ly.N_DOF))

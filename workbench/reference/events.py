@@ -79,7 +79,8 @@ class ReferenceRun:
     ``log`` the events (dicts: t, kind, from_regime, to_regime, point,
     ke_lost), ``y`` the final state, ``t`` and ``samples`` (n, 18) the
     states at the requested sample times reached, ``nfev`` the solver's
-    right-hand-side evaluations, ``regime`` the final regime.
+    right-hand-side evaluations, ``regime`` the final regime,
+    ``fallbacks`` the segments integrated by FALLBACK_METHOD instead.
     """
 
     log: list
@@ -88,6 +89,17 @@ class ReferenceRun:
     samples: np.ndarray = field(default_factory=lambda: np.zeros((0, 2 * N)))
     nfev: int = 0
     regime: Regime = Regime()
+    fallbacks: int = 0
+
+
+#: The method of a segment whose event location failed on LSODA's dense output.
+#: solve_ivp brackets an event between the solver's states at a step's ends,
+#: then solves for it on the dense output; LSODA's interpolant need not pass
+#: through the state at the step's start, so an event value near zero there
+#: (a restart just after a transition) can take the other sign, and brentq
+#: stops with "f(a) and f(b) must have different signs".  Radau's
+#: collocation polynomial passes through both ends, so that cannot happen.
+FALLBACK_METHOD = "Radau"
 
 
 class HybridReference:
@@ -422,16 +434,20 @@ class HybridReference:
         at_end = bool(want.size) and abs(want[-1] - t1) <= 1e-12 * max(1.0, abs(t1))
         if at_end:
             want = want[:-1]
-        times, samples, nfev = [], [], 0
+        times, samples, nfev, fallbacks = [], [], 0, 0
         if want.size and want[0] == t0:
             times.append(t0)
             samples.append(y.copy())
         while t < t1 and len(log) < max_events:
             evs = self.events(reg, y)
             asked = want[want > t]
-            sol = solve_ivp(lambda tt, yy, r=reg: self.solve(tt, yy, r)[0], (t, t1), y,
-                            method=self.method, rtol=self.rtol, atol=self.atol, events=evs,
-                            t_eval=np.append(asked, t1))
+            try:
+                sol = self._segment(t, t1, y, reg, evs, asked, self.method)
+            except ValueError as exc:
+                if self.method != "LSODA" or "different signs" not in str(exc):
+                    raise
+                sol = self._segment(t, t1, y, reg, evs, asked, FALLBACK_METHOD)
+                fallbacks += 1
             nfev += sol.nfev
             if not sol.success:
                 raise RuntimeError(sol.message)
@@ -440,15 +456,22 @@ class HybridReference:
                     times.append(tt)
                     samples.append(yy)
             if sol.status == 0:
-                return self._result(log, sol.y[:, -1], times, samples, nfev, reg)
+                return self._result(log, sol.y[:, -1], times, samples, nfev, reg, fallbacks)
             hits = [(te[0], k) for k, te in enumerate(sol.t_events) if len(te)]
             t, k = min(hits)
             y = sol.y_events[k][0]
             y, reg, row = self.transition(t, y, evs[k], reg)
             log.append(row)
-        return self._result(log, y, times, samples, nfev, reg)
+        return self._result(log, y, times, samples, nfev, reg, fallbacks)
+
+    def _segment(self, t, t1, y, reg, evs, asked, method):
+        """solve_ivp in regime ``reg`` from (t, y) to t1 or its first event."""
+        return solve_ivp(lambda tt, yy, r=reg: self.solve(tt, yy, r)[0], (t, t1), y,
+                         method=method, rtol=self.rtol, atol=self.atol, events=evs,
+                         t_eval=np.append(asked, t1))
 
     @staticmethod
-    def _result(log, y, times, samples, nfev, reg):
+    def _result(log, y, times, samples, nfev, reg, fallbacks):
         return ReferenceRun(log=log, y=np.asarray(y), t=np.array(times),
-                            samples=np.array(samples).reshape(-1, 2 * N), nfev=nfev, regime=reg)
+                            samples=np.array(samples).reshape(-1, 2 * N), nfev=nfev, regime=reg,
+                            fallbacks=fallbacks)
