@@ -76,9 +76,9 @@ def test_reference_drive_agrees_with_the_kernels(ex):
         assert force(t) == pytest.approx(shaker_force(t, ex), rel=1e-12, abs=1e-9)
 
 
-def test_a_failed_event_location_on_lsoda_is_redone_by_radau(monkeypatch):
+def test_a_failed_event_location_on_lsoda_is_redone_by_the_fallback_method(monkeypatch):
     """scipy's brentq on LSODA's dense output can find no sign change (FALLBACK_METHOD's
-    docstring): that segment is integrated again by Radau, and the run goes on."""
+    docstring): that segment is integrated again by FALLBACK_METHOD, and the run goes on."""
     p = Parameters()
     kernel = simulate(p, None, 0.024, dt=KERNEL_DT, initial="paper")
     cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]

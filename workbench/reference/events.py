@@ -97,9 +97,12 @@ class ReferenceRun:
 #: then solves for it on the dense output; LSODA's interpolant need not pass
 #: through the state at the step's start, so an event value near zero there
 #: (a restart just after a transition) can take the other sign, and brentq
-#: stops with "f(a) and f(b) must have different signs".  Radau's
-#: collocation polynomial passes through both ends, so that cannot happen.
-FALLBACK_METHOD = "Radau"
+#: stops with "f(a) and f(b) must have different signs".  DOP853's dense
+#: output is y_old plus terms that vanish at the step's start, so that cannot
+#: happen.  (Radau's collocation polynomial would do as well, but with the
+#: Jacobian by differences of this slow right-hand side it did not finish a
+#: 200 N window in 25 minutes.)
+FALLBACK_METHOD = "DOP853"
 
 
 class HybridReference:
