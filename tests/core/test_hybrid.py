@@ -178,6 +178,26 @@ def paper_start_run():
     return simulate(Parameters(), None, 1.0, initial="paper")
 
 
+def test_a_runs_summary_agrees_with_its_dataframes(paper_start_run):
+    """The summary is computed from the kernel's arrays; the DataFrames give the same figures."""
+    from workbench.study.metrics import contact_shares
+    run = paper_start_run
+    s = run.summary()
+    e = run.energy
+    last = e.iloc[-1]
+    scale = (abs(last.w_excitation) + last.d_structural + last.d_cork + last.d_friction
+             + last.d_impact + e.e_kin.max() + (e.total - e.total.iloc[0]).abs().max())
+    assert s["energy_balance_rel"] == pytest.approx(e.residual.abs().max() / scale, rel=1e-12)
+    shares = contact_shares(run.events, float(run.events.t.iloc[0]), run.t_end)
+    assert s["contact_time_share"] == pytest.approx(shares, rel=1e-12)
+    assert s["n_events"] == int((run.events.kind != "start").sum()) > 5
+    assert s["n_impacts"] == int((run.events.kind == "impact").sum())
+    assert s["regimes_visited"] == sorted(set(run.events.to_regime) | set(run.signals.regime))
+    assert s["strain1_rms"] == pytest.approx(run.signals.strain1.std(ddof=0), rel=1e-12)
+    tip = run.signals.tip_y - run.static_tip_y
+    assert s["tip_disp_peak_cm"] == pytest.approx(tip.abs().max(), rel=1e-12)
+
+
 def test_paper_start_run_is_consistent(paper_start_run):
     run = paper_start_run
     assert run.ok, run.message
@@ -353,6 +373,18 @@ def test_a_run_continued_from_its_state_follows_the_whole_run():
     assert len(rest.events) - 1 == len(later) > 0
     assert np.allclose(rest.events.t.iloc[1:], later.t, atol=1e-9)
     assert np.abs(rest.signals.tip_y.to_numpy() - sig.tip_y.to_numpy()[k:]).max() < 1e-7
+
+
+def test_cli_run_json_leaves_pandas_unimported():
+    """`workbench run --json` needs no DataFrame, so a fresh process does not import pandas
+    (a third of a second of its start)."""
+    import subprocess
+    import sys
+    code = ("import sys; from workbench.cli import main; rc = main(['run', '--gap-mm', '1.016', "
+            "'--freq-hz', '20', '--force-n', '20', '--duration', '0.05', '--json']); "
+            "print(rc, 'pandas' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split()[-2:] == ["0", "False"]
 
 
 def test_cli_run_json(capsys):

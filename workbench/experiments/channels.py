@@ -26,11 +26,14 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from ..model.params import ParameterError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Table 2's sensor names, as the files write them, by workbench channel.
 TABLE2_NAMES = {"force1": "Force1", "strain1": "Strain1", "accel1": "Accel1",
@@ -155,6 +158,7 @@ def record(path, t: np.ndarray, data: np.ndarray, channels: list[str], factors: 
     if len(bad):
         raise ExperimentFileError(path, None, f"{TABLE2_NAMES[channels[bad[0]]]}: values that are "
                                   "not finite, or out of range in CGS units")
+    import pandas as pd                 # here: a simulation's command line does not need it
     df = pd.DataFrame(values, columns=channels, index=pd.Index(np.asarray(t, dtype=float), name="t"))
     df.attrs.update(meta=meta, units_assumed=assumed, source=str(path))
     return df

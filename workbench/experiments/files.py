@@ -21,11 +21,13 @@ from __future__ import annotations
 
 import importlib
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from .channels import (CHANNELS, DEFAULT_UNITS, TABLE2_NAMES, UNITS,  # noqa: F401 - the interface
                        ExperimentFileError, kind)
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Format name -> the suffixes that choose it.
 FORMATS = {"lvm": (".lvm",), "text": (".txt", ".tsv", ".dat", ".tab"), "tdms": (".tdms",),

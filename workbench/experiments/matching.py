@@ -11,12 +11,15 @@ The duration and sample rate are the record's.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from ..model.params import ParameterError, Parameters, resolve_name
 from ..model import drives
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)

@@ -13,22 +13,26 @@ Units are CGS (docs/model.md); ``run.units`` names them per column.
 """
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from . import packing as mdl
 from ..core import layout as ly
 from ..core.hybrid import run_hybrid
 from .excitation import none
 from .limits import MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD
-from ..study.metrics import contact_shares
+from ..study.metrics import contact_shares_of
 from .params import ParameterError, Parameters, check_positive
 from .regimes import contact_code, in_contact, is_stick, set_of
 from .statics import static_equilibrium, tip_load_for_deflection
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 DEFAULT_OUTPUT_HZ = 1000.0
 #: Steps :func:`default_dt` chooses from (s): 1 ms / n for n = 10 ... 200, so that each
@@ -201,9 +205,29 @@ ENERGY_COLUMNS = ["e_kin", "e_elastic", "e_gravity", "e_cork", "w_excitation", "
                   "d_cork", "d_friction", "d_impact", "w_constraint"]
 
 
+def energy_account(columns) -> tuple:
+    """The total mechanical energy E and the balance residual (erg) of the energy columns.
+
+    ``columns`` maps the names of ENERGY_COLUMNS to NumPy arrays:
+    residual = E - E(0) - W_excitation + D_structural + D_cork + D_friction + D_impact.
+    """
+    c = columns
+    total = c["e_kin"] + c["e_elastic"] + c["e_gravity"] + c["e_cork"]
+    residual = (total - total[0] - c["w_excitation"] + c["d_structural"] + c["d_cork"]
+                + c["d_friction"] + c["d_impact"])
+    return total, residual
+
+
 @dataclass
 class Run:
-    """The result of :func:`simulate`."""
+    """The result of :func:`simulate`.
+
+    The samples and the event log are kept as the kernel wrote them
+    (``t``, ``states``, ``sensors``, ``log``); :attr:`signals` and
+    :attr:`events` are DataFrames of them, built on first use (pandas is
+    not imported until then, so a run whose summary is all that is wanted
+    does not pay for it).
+    """
 
     params: Parameters
     excitation: np.ndarray
@@ -212,8 +236,10 @@ class Run:
     status: int
     message: str
     wall_s: float
-    signals: pd.DataFrame
-    events: pd.DataFrame
+    t: np.ndarray               # sample times (s), (n,)
+    states: np.ndarray          # (q, q') at the samples, (n, 18), CGS
+    sensors: np.ndarray         # the kernel's signals (layout SIGNALS), (n, N_SIG)
+    log: np.ndarray             # the event log (layout LOG_*), (n_events, N_LOG)
     stats: dict
     static_tip_y: float
     initial: str
@@ -235,6 +261,38 @@ class Run:
         """Simulated seconds: the time reached minus the start time t0."""
         return self.t_end - self.t0
 
+    @functools.cached_property
+    def signals(self) -> pd.DataFrame:
+        """DataFrame indexed by time t (s): q, q', the signals of SIGNALS, contact flags."""
+        import pandas as pd
+        df = pd.DataFrame(self.states, columns=Q_COLUMNS + QD_COLUMNS)
+        for j, name in enumerate(ly.SIGNALS):
+            df[name] = self.sensors[:, j]
+        df["regime"] = df["regime"].astype(np.int16)
+        regimes = df["regime"].to_numpy()
+        for k in range(ly.N_POINTS):
+            df[f"contact{k + 1}"] = in_contact(k, regimes)
+        df["contact_code"] = contact_code(regimes).astype(np.int16)
+        df.index = pd.Index(self.t, name="t")
+        return df
+
+    @functools.cached_property
+    def events(self) -> pd.DataFrame:
+        """DataFrame of the event log: time, kind, from/to regime, point, impulses, energy lost."""
+        import pandas as pd
+        logs = self.log
+        return pd.DataFrame({
+            "t": logs[:, ly.LOG_T],
+            "kind": pd.Categorical([ly.EVENT_KINDS[int(k)] for k in logs[:, ly.LOG_KIND]],
+                                   categories=ly.EVENT_KINDS),
+            "from_regime": logs[:, ly.LOG_FROM].astype(np.int16),
+            "to_regime": logs[:, ly.LOG_TO].astype(np.int16),
+            "point": logs[:, ly.LOG_POINT].astype(np.int8),
+            **{f"impulse_n{k + 1}": logs[:, ly.LOG_P + k] for k in range(ly.N_POINTS)},
+            "impulse_t": logs[:, ly.LOG_PT],
+            "ke_lost": logs[:, ly.LOG_DKE],
+        })
+
     @property
     def transitions(self) -> pd.DataFrame:
         """Counts of (from_regime, to_regime) over the events, starting event excluded."""
@@ -243,15 +301,14 @@ class Run:
 
     @property
     def energy(self) -> pd.DataFrame:
-        """The energy account (erg) with the total E and the balance residual.
-
-        residual = E - E(0) - W_excitation + D_structural + D_cork + D_friction + D_impact
-        """
+        """The energy account (erg) with the total E and the balance residual (:func:`energy_account`)."""
         e = self.signals[ENERGY_COLUMNS].copy()
-        e["total"] = e.e_kin + e.e_elastic + e.e_gravity + e.e_cork
-        e["residual"] = (e.total - e.total.iloc[0] - e.w_excitation + e.d_structural + e.d_cork
-                         + e.d_friction + e.d_impact)
+        e["total"], e["residual"] = energy_account(
+            {name: e[name].to_numpy() for name in ENERGY_COLUMNS})
         return e
+
+    def _sensor(self, name: str) -> np.ndarray:
+        return self.sensors[:, ly.SIGNALS.index(name)]
 
     def energy_balance_rel(self) -> float:
         """Largest |residual| over the run's energy scale (docs/model.md §9).
@@ -263,22 +320,25 @@ class Run:
         ENERGY_SCALE_FLOOR_ERG: a run that stays at rest divides its
         round-off residual by 1 erg, not by a near-zero throughput.
         """
-        e = self.energy
-        last = e.iloc[-1]
-        scale = (abs(last.w_excitation) + last.d_structural + last.d_cork + last.d_friction
-                 + last.d_impact + float(e.e_kin.max())
-                 + float(np.abs(e.total - e.total.iloc[0]).max()))
-        return float(np.abs(e.residual).max() / max(scale, ENERGY_SCALE_FLOOR_ERG))
+        c = {name: self._sensor(name) for name in ENERGY_COLUMNS}
+        total, residual = energy_account(c)
+        last = {name: float(x[-1]) for name, x in c.items()}
+        scale = (abs(last["w_excitation"]) + last["d_structural"] + last["d_cork"]
+                 + last["d_friction"] + last["d_impact"] + float(c["e_kin"].max())
+                 + float(np.abs(total - total[0]).max()))
+        return float(np.abs(residual).max() / max(scale, ENERGY_SCALE_FLOOR_ERG))
 
     def contact_time_share(self) -> dict[str, float]:
         """Fraction of the simulated time spent in each contact code (from the event log)."""
-        return contact_shares(self.events, float(self.events.t.iloc[0]), self.t_end)
+        return contact_shares_of(self.log[:, ly.LOG_T], self.log[:, ly.LOG_TO],
+                                 float(self.log[0, ly.LOG_T]), self.t_end)
 
     def summary(self) -> dict:
         """Scalar results of the run (the ``workbench run --json`` object)."""
-        sig = self.signals
-        visited = set(int(r) for r in self.events.to_regime) | set(int(r) for r in sig.regime)
-        tip = sig.tip_y - self.static_tip_y
+        kinds = self.log[:, ly.LOG_KIND]
+        visited = (set(int(r) for r in self.log[:, ly.LOG_TO])
+                   | set(int(r) for r in self._sensor("regime")))
+        tip = self._sensor("tip_y") - self.static_tip_y
         return {
             "status": "ok" if self.ok else "failed",
             "status_code": self.status,
@@ -288,8 +348,8 @@ class Run:
             "compile_s": self.compile_s,
             "dt": self.dt,
             "initial": self.initial,
-            "n_events": int((self.events.kind != "start").sum()),
-            "n_impacts": int((self.events.kind == "impact").sum()),
+            "n_events": int((kinds != ly.KIND_START).sum()),
+            "n_impacts": int((kinds == ly.KIND_IMPACT).sum()),
             "regimes_visited": sorted(visited),
             "contact_time_share": self.contact_time_share(),
             "max_penetration_cm": float(self.stats["max_penetration_cm"]),
@@ -299,8 +359,8 @@ class Run:
             "energy_balance_rel": self.energy_balance_rel(),
             "impact_energy_lost_erg": float(self.stats["impact_energy_lost_erg"]),
             **{key: self.stats[key] for key in CONTACT_STAT_KEYS},
-            "strain1_rms": float(np.std(sig.strain1)),
-            "strain2_rms": float(np.std(sig.strain2)),
+            "strain1_rms": float(np.std(self._sensor("strain1"))),
+            "strain2_rms": float(np.std(self._sensor("strain2"))),
             "tip_disp_peak_cm": float(np.abs(tip).max()),
         }
 
@@ -465,26 +525,6 @@ def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s,
     ys = np.concatenate(parts_y)
     sig = np.concatenate(parts_s)
     logs = np.concatenate(parts_log) if parts_log else np.empty((0, ly.N_LOG))
-    df = pd.DataFrame(ys, columns=Q_COLUMNS + QD_COLUMNS)
-    for j, name in enumerate(ly.SIGNALS):
-        df[name] = sig[:, j]
-    df["regime"] = df["regime"].astype(np.int16)
-    regimes = df["regime"].to_numpy()
-    for k in range(ly.N_POINTS):
-        df[f"contact{k + 1}"] = in_contact(k, regimes)
-    df["contact_code"] = contact_code(regimes).astype(np.int16)
-    df.index = pd.Index(t, name="t")
-    events = pd.DataFrame({
-        "t": logs[:, ly.LOG_T],
-        "kind": pd.Categorical([ly.EVENT_KINDS[int(k)] for k in logs[:, ly.LOG_KIND]],
-                               categories=ly.EVENT_KINDS),
-        "from_regime": logs[:, ly.LOG_FROM].astype(np.int16),
-        "to_regime": logs[:, ly.LOG_TO].astype(np.int16),
-        "point": logs[:, ly.LOG_POINT].astype(np.int8),
-        **{f"impulse_n{k + 1}": logs[:, ly.LOG_P + k] for k in range(ly.N_POINTS)},
-        "impulse_t": logs[:, ly.LOG_PT],
-        "ke_lost": logs[:, ly.LOG_DKE],
-    })
     units = {n: u for n, u in zip(ly.COORD_NAMES, ly.COORD_UNITS)}
     units.update({f"{n}_dot": f"{u}/s" for n, u in zip(ly.COORD_NAMES, ly.COORD_UNITS)})
     units.update(dict(zip(ly.SIGNALS, ly.SIGNAL_UNITS)))
@@ -504,5 +544,5 @@ def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s,
              "stepped_energy_lost_erg": st[ly.ST_E_STEPPED],
              "s_min_cm": st[ly.ST_S_MIN], "s_max_cm": st[ly.ST_S_MAX]}
     return Run(params=params, excitation=ex, dt=dt, duration=duration, status=int(status),
-               message=ly.MESSAGES[int(status)], wall_s=wall, signals=df, events=events,
+               message=ly.MESSAGES[int(status)], wall_s=wall, t=t, states=ys, sensors=sig, log=logs,
                stats=stats, static_tip_y=static_tip, initial=label, units=units, t0=t0)

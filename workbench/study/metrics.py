@@ -110,8 +110,11 @@ def once_per_period(t: np.ndarray, x: np.ndarray, f_hz: float) -> np.ndarray:
 
 def regime_time(events, t0: float, t1: float) -> dict[int, float]:
     """Time (s) spent in each regime within [t0, t1], from the event log."""
-    times = events.t.to_numpy()
-    to_regime = events.to_regime.to_numpy()
+    return regime_time_of(events.t.to_numpy(), events.to_regime.to_numpy(), t0, t1)
+
+
+def regime_time_of(times, to_regime, t0: float, t1: float) -> dict[int, float]:
+    """:func:`regime_time` of the event times (s) and the regimes they enter."""
     out: dict[int, float] = {}
     for k in range(len(times)):
         start = max(times[k], t0)
@@ -126,8 +129,13 @@ def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
 
     ``events`` has columns t and to_regime (a run's events, or a reference's log).
     """
+    return contact_shares_of(events.t.to_numpy(), events.to_regime.to_numpy(), t0, t1)
+
+
+def contact_shares_of(times, to_regime, t0: float, t1: float) -> dict[str, float]:
+    """:func:`contact_shares` of the event times (s) and the regimes they enter."""
     share: dict[str, float] = {}
-    for reg, dur in regime_time(events, t0, t1).items():
+    for reg, dur in regime_time_of(times, to_regime, t0, t1).items():
         code = str(regimes.contact_code(reg))
         share[code] = share.get(code, 0.0) + dur
     total = t1 - t0
