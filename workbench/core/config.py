@@ -9,7 +9,7 @@ or ``cache`` flags.  Tolerances used by more than one module live here too.
 #: NaN status check) instead of raising inside the kernel.
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
-#: Smallest pivot accepted by the Cholesky factorisation of the mass matrix,
+#: Smallest pivot accepted by the LDL^T factorisation of the mass matrix,
 #: relative to the largest diagonal entry.
 CHOLESKY_REL_PIVOT = 1e-14
 

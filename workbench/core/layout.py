@@ -161,7 +161,7 @@ N_RECS = 6
 
 # --- work matrices and vectors -----------------------------------------------
 KC_K, KC_C = 0, 1                # kc (2, 9, 9): stiffness, damping
-MAT_M, MAT_CHOL = 0, 1           # mat (2, 9, 9): mass matrix, its Cholesky factor
+MAT_M, MAT_CHOL = 0, 1           # mat (2, 9, 9): mass matrix, its LDL^T factor (dynamics._factor)
 VEC_H, VEC_Q, VEC_RHS, VEC_AUX = 0, 1, 2, 3  # vec (4, 9): h = sum m J^T kappa, forces, Q - h,
 AUX_VGRAV, AUX_P_EXT, AUX_F_SHAKER, AUX_F_HAMMER, AUX_P_DAMP = 0, 1, 2, 3, 4   # and scalars of the last rhs:
 N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer forces (dyn),
