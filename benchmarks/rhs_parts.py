@@ -5,7 +5,7 @@
 Each part runs 100 000 times inside a compiled loop (a Python call would
 time numba's argument unboxing instead), 7 rounds, median per call (µs):
 the mass matrix, h and gravity (``assemble_inertia``), the applied forces,
-the Cholesky factor of M, the whole free-flight ``rhs``, ``rhs_regime`` in
+the LDL^T factor of M, the whole free-flight ``rhs``, ``rhs_regime`` in
 free flight, single and double contact, one RK4 step, and what a step adds
 besides its right-hand sides: the projection onto the regime
 (``project``) and the event functions (``event_values``).  The state is a
@@ -25,7 +25,7 @@ from workbench.core.integrate import rk4_step
 from workbench.model.excitation import sine
 from workbench.model.params import Parameters
 
-PARTS = ("mass matrix, h, gravity", "applied forces", "Cholesky of M", "rhs (free flight)",
+PARTS = ("mass matrix, h, gravity", "applied forces", "factor of M (LDL^T)", "rhs (free flight)",
          "rhs_regime", "RK4 step", "projection", "event functions")
 RHS, RHS_REGIME = 3, 4              # the indices of the whole right-hand sides in PARTS
 
