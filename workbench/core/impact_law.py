@@ -387,6 +387,11 @@ def lemke_impact(G, u, mu, m, lw, P):
         for i in range(2 * m):
             P[i] = 0.0
         return True
+    # ratios within round-off of q's scale are ties (an absolute tie would merge
+    # every ratio of a problem whose rates are themselves of order 1e-16)
+    tie = 1e-15 * max(-qmin, 1e-300)
+    for i in range(n):
+        tie = max(tie, 1e-15 * abs(T[i, 2 * n + 1]))
     entering = 2 * n
     done = False
     for _ in range(50 * n):
@@ -404,7 +409,7 @@ def lemke_impact(G, u, mu, m, lw, P):
             a = T[i, entering]
             if a > 1e-12:
                 ratio = T[i, 2 * n + 1] / a
-                if ratio < best - 1e-15 or (abs(ratio - best) <= 1e-15 and int(basis[i]) == 2 * n):
+                if ratio < best - tie or (abs(ratio - best) <= tie and int(basis[i]) == 2 * n):
                     best = ratio
                     r = i
         if r < 0:
