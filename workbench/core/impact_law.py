@@ -389,7 +389,7 @@ def lemke_impact(G, u, mu, m, lw, P):
         return True
     # ratios within round-off of q's scale are ties (an absolute tie would merge
     # every ratio of a problem whose rates are themselves of order 1e-16)
-    tie = 1e-15 * max(-qmin, 1e-300)
+    tie = 1e-300
     for i in range(n):
         tie = max(tie, 1e-15 * abs(T[i, 2 * n + 1]))
     entering = 2 * n
