@@ -396,6 +396,29 @@ def test_cli_run_json_leaves_pandas_unimported():
     assert out.stdout.split()[-2:] == ["0", "False"]
 
 
+def test_the_process_entry_point_keeps_exit_codes_and_output(tmp_path):
+    """`python -m workbench` (cli.entry: collector tuned, survivors frozen before exit) returns
+    main's exit codes and leaves its output file whole; main() alone leaves the collector be."""
+    import gc
+    import subprocess
+    import sys
+
+    from workbench.cli import EXIT_BAD_INPUT, main
+    import pandas as pd
+    out = tmp_path / "run.parquet"
+    base = [sys.executable, "-m", "workbench", "run", "--gap-mm", "1.016", "--freq-hz", "20",
+            "--force-n", "20", "--duration", "0.05", "--output-hz", "2000"]
+    done = subprocess.run(base + ["--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    table = pd.read_parquet(out)
+    assert len(table) == 101 and np.all(np.isfinite(table["tip_y"]))
+    refused = subprocess.run(base + ["--dt", "-1"], capture_output=True, text=True)
+    assert refused.returncode == EXIT_BAD_INPUT and "--dt" in refused.stderr
+    before = gc.get_threshold()
+    assert main(["params", "--json"]) == 0
+    assert gc.get_threshold() == before and gc.get_freeze_count() == 0
+
+
 def test_cli_run_json(capsys):
     import json
 
