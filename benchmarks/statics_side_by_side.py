@@ -8,7 +8,8 @@ models), the 1.016 mm cubic model with and without the tip mass under tip
 loads of -20, -5, 5 and 20 N, two friction coefficients at 0.762 mm, and the
 locked joint.  ``save`` writes each model's contact set, whether friction
 holds, and q (or the error); ``compare`` counts the models whose results are
-bitwise the same and names the others.  Both print the wall time of the
+bitwise the same and names the others with their largest difference of q
+(cm or rad).  Both print the wall time of the
 static starts (one process: the first model also loads the kernels).
 """
 import itertools
@@ -58,8 +59,10 @@ def main(argv):
     print(json.dumps({"bitwise_same": same, "of": len(results)}))
     for (changes, load, fixed), a, b in zip(models(), saved, results):
         if a != b:
+            dq = (max(abs(x - y) for x, y in zip(a[2], b[2]))
+                  if a[0] != "error" and b[0] != "error" else None)
             print(json.dumps({"differs": changes, "tip_load_n": load, "fixed": list(fixed),
-                              "saved": a[:2], "now": b[:2]}))
+                              "saved": a[:2], "now": b[:2], "largest_dq": dq}))
 
 
 if __name__ == "__main__":

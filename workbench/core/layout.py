@@ -125,6 +125,12 @@ MESSAGES = {
     LOG_FULL: "the event log is full (the run continues in a new chunk)",
 }
 
+# --- status codes of the static equilibrium (workbench.core.equilibrium) -------
+EQ_CONVERGED = 0
+EQ_DAMPED_OUT = 1       # damped Newton steps in a row: no equilibrium near the start
+EQ_SINGULAR = 2         # the Jacobian has a zero pivot
+EQ_NOT_CONVERGED = 3    # the iteration limit was reached
+
 # --- rows of the shape table ``tab`` -----------------------------------------
 # tab has 2 n_gauss + N_PTS rows: beam A's Gauss points, beam B's Gauss
 # points, then these special points (row 2 n_gauss + R_*).

@@ -10,10 +10,10 @@ For each contact set the equations
     g_k(q) = 0                                     (the set's points)
     s = s0                                         (friction holds the slide)
 
-are solved by a damped Newton method with a finite-difference Jacobian (a
-set that needs _MAX_DAMPED_IN_A_ROW damped steps in a row has no
-equilibrium near the start and is given up); Q is the
-kernel's generalised force at rest (gravity, elastic, cork) plus the tip
+are solved by the compiled damped Newton iteration of
+:mod:`workbench.core.equilibrium` (a set that needs _MAX_DAMPED_IN_A_ROW
+damped steps in a row has no equilibrium near the start and is given up);
+Q is the generalised force at rest (gravity, elastic, cork) plus the tip
 load.  Friction is indeterminate in statics; the slide is held where the
 joint was assembled (s0, default 0) by the tangential force lambda_t of the
 set's first point, and the solution is accepted only if that force lies in
@@ -32,15 +32,11 @@ import numpy as np
 
 from . import packing as mdl
 from ..core import layout as ly
-from ..core.contact import eval_geometry
-from ..core.dynamics import energies, eval_rhs
-from ..core.kinematics import element_kinematics
+from ..core.equilibrium import newton_set, static_state
 from .excitation import DYN_PER_N, none
 from .params import ParameterError, Parameters
 from .regimes import CONTACT_CODES, SETS
 
-_FORCE_SCALE = 1e5     # dyn: scales the force rows of the Newton residual
-_GAP_SCALE = 1e-3      # cm: scales the gap rows
 _TOL = 1e-10           # scaled residual at convergence
 _MAX_NEWTON = 60
 #: A set whose Newton iteration needs this many damped steps in a row has no
@@ -68,7 +64,7 @@ class Equilibrium:
 
 
 class _Statics:
-    """Residuals of the static equations of one model."""
+    """One model's static problem: its kernel arrays and the tip load (dyn)."""
 
     def __init__(self, p: Parameters, fixed, tip_load_dyn: float):
         self.p = p
@@ -77,123 +73,59 @@ class _Statics:
         self.ex = none()
         self.tip_load = tip_load_dyn
         self.free = list(self.model.free)
-        n_el = 2 * p.n_gauss + 3
-        self._kin = [np.zeros((n_el, 2)), np.zeros((n_el, 2, ly.N_DOF)), np.zeros((n_el, 2)),
-                     np.zeros((n_el, ly.N_DOF)), np.zeros(n_el), np.zeros(n_el), np.zeros(n_el)]
-        self._cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
-        self._ydot = np.zeros(ly.N_STATE)
 
-    def force(self, q):
-        """Generalised force at rest (dyn, dyn cm) and the tip's height (cm)."""
-        y = np.concatenate([q, np.zeros(ly.N_DOF)])
-        eval_rhs(0.0, y, *self.model, self.ex, *self.work, self._ydot)
-        Q = self.work.vec[ly.VEC_RHS].copy()
-        r, J = self._kin[0], self._kin[1]
-        element_kinematics(q, np.zeros(ly.N_DOF), self.model.P, self.model.tab, self.work.rec,
-                           *self._kin)
-        Q += self.tip_load * J[-1, 1]          # the last element is the tip point
-        return Q, r[-1, 1]
+    def unknowns(self, set_index: int, hold_s: bool):
+        """The coordinates and contact points of a set's unknowns (int64 arrays), and whether
+        friction holds the slide."""
+        coords = [i for i in self.free if not (hold_s and i == ly.S)]
+        friction = hold_s and ly.S in self.free and set_index > 0
+        return (np.array(coords, dtype=np.int64), np.array(SETS[set_index], dtype=np.int64),
+                friction)
 
-    def geometry(self, q):
-        eval_geometry(q, self.model.P, self._cg)
-        grad = self._cg[:, [ly.CG_DS, ly.CG_DV, ly.CG_DPSI]]
-        return self._cg[:, ly.CG_VAL].copy(), grad.copy()
+    def newton(self, z, q_base, set_index: int, hold_s: bool) -> bool:
+        """Solve the set's equations from z (overwritten); True when converged."""
+        coords, points, friction = self.unknowns(set_index, hold_s)
+        status = newton_set(z, q_base, coords, points, friction, self.tip_load, _TOL, _MAX_NEWTON,
+                            _MAX_DAMPED_IN_A_ROW, *self.model, self.ex, *self.work)
+        return status == ly.EQ_CONVERGED
 
-    def potential(self, q):
-        out = np.zeros(4)
-        energies(np.concatenate([q, np.zeros(ly.N_DOF)]), *self.model, *self.work, out)
-        _, tip_y = self.force(q)
-        return out[1] + out[2] + out[3] - self.tip_load * tip_y
-
-
-def _unknowns(st: _Statics, set_index: int, hold_s: bool):
-    coords = [i for i in st.free if not (hold_s and i == ly.S)]
-    points = list(SETS[set_index])
-    friction = hold_s and ly.S in st.free and set_index > 0
-    return coords, points, friction
-
-
-def _residual(st: _Statics, z, q_base, set_index, hold_s):
-    coords, points, friction = _unknowns(st, set_index, hold_s)
-    q = q_base.copy()
-    q[coords] = z[:len(coords)]
-    lam = z[len(coords):]
-    Q, _ = st.force(q)
-    gval, grad = st.geometry(q)
-    joint = [ly.S, ly.V, ly.PSI]
-    for k, p in enumerate(points):
-        Q[joint] += lam[k] * grad[ly.CG_G + p]
-    if friction:
-        Q[joint] += lam[len(points)] * grad[ly.CG_T + points[0]]
-    rows = list(coords) + ([ly.S] if friction else [])
-    res = [Q[rows] / _FORCE_SCALE, gval[[ly.CG_G + p for p in points]] / _GAP_SCALE]
-    return np.concatenate(res), q, Q
-
-
-def _newton(st: _Statics, q_guess, set_index, hold_s):
-    coords, points, friction = _unknowns(st, set_index, hold_s)
-    n_lam = len(points) + (1 if friction else 0)
-    z = np.concatenate([q_guess[coords], np.zeros(n_lam)])
-    q_base = q_guess.copy()
-    f, q, _ = _residual(st, z, q_base, set_index, hold_s)
-    damped = 0
-    for _ in range(_MAX_NEWTON):
-        norm = np.max(np.abs(f))
-        if norm < _TOL:
-            return z, q
-        if damped >= _MAX_DAMPED_IN_A_ROW:
-            return None, None
-        J = np.empty((f.size, z.size))
-        for j in range(z.size):
-            step = 1e-7 * max(1.0, abs(z[j])) if j < len(coords) else 1e-3 * max(1.0, abs(z[j]))
-            zp = z.copy()
-            zp[j] += step
-            zm = z.copy()
-            zm[j] -= step
-            J[:, j] = (_residual(st, zp, q_base, set_index, hold_s)[0]
-                       - _residual(st, zm, q_base, set_index, hold_s)[0]) / (2 * step)
-        try:
-            dz = np.linalg.solve(J, -f)
-        except np.linalg.LinAlgError:
-            return None, None
-        alpha = 1.0
-        while alpha > 1e-4:
-            f_new, q_new, _ = _residual(st, z + alpha * dz, q_base, set_index, hold_s)
-            if np.all(np.isfinite(f_new)) and np.max(np.abs(f_new)) < (1 - 0.25 * alpha) * norm:
-                break
-            alpha *= 0.5
-        damped = damped + 1 if alpha < 1.0 else 0
-        z = z + alpha * dz
-        f, q = f_new, q_new
-    return (z, q) if np.max(np.abs(f)) < _TOL else (None, None)
+    def state(self, z, q_base, set_index: int, hold_s: bool):
+        """q, the force with the contact forces Q (dyn, dyn cm), the gaps (cm), the potential
+        energy (erg) and the tip's height (cm) of unknowns z."""
+        coords, points, friction = self.unknowns(set_index, hold_s)
+        q, Q, f, energy = np.zeros(ly.N_DOF), np.zeros(ly.N_DOF), np.zeros(z.size), np.zeros(4)
+        static_state(z, q_base, coords, points, friction, self.tip_load, *self.model, self.ex,
+                     *self.work, q, Q, f, energy)
+        gaps = self.work.cg[ly.CG_G:ly.CG_G + ly.N_POINTS, ly.CG_VAL].copy()
+        potential = energy[0] + energy[1] + energy[2] - self.tip_load * energy[3]
+        return q, Q, gaps, potential, energy[3]
 
 
 def _solve_set(st: _Statics, q_guess, set_index, hold_s):
-    """Equilibrium in one contact set, or None if it fails or is inadmissible."""
-    z, q = _newton(st, q_guess, set_index, hold_s)
-    if z is None:
+    """Equilibrium in one contact set and its potential energy (erg), or None if it fails
+    or is inadmissible."""
+    coords, points, friction = st.unknowns(set_index, hold_s)
+    z = np.concatenate([q_guess[coords], np.zeros(points.size + (1 if friction else 0))])
+    q_base = q_guess.copy()
+    if not st.newton(z, q_base, set_index, hold_s):
         return None
-    coords, points, friction = _unknowns(st, set_index, hold_s)
-    lam = z[len(coords):]
-    gval, _ = st.geometry(q)
+    q, Q, gaps, potential, tip_y = st.state(z, q_base, set_index, hold_s)
     lambda_n = np.zeros(ly.N_POINTS)
-    for k, p in enumerate(points):
-        lambda_n[p] = lam[k]
-    lambda_t = lam[len(points)] if friction else 0.0
+    lambda_n[points] = z[coords.size:coords.size + points.size]
+    lambda_t = z[-1] if friction else 0.0
     scale = max(1.0, np.max(np.abs(lambda_n)))
     if np.any(lambda_n < -1e-9 * scale):
         return None
     others = [p for p in range(ly.N_POINTS) if p not in points]
-    if np.any(gval[[ly.CG_G + p for p in others]] < -1e-12):
+    if np.any(gaps[others] < -1e-12):
         return None
     held = abs(lambda_t) <= st.p.mu_s * lambda_n.sum() * (1 + 1e-12)
     if friction and not held:
         return None
-    _, Q = _residual(st, z, q, set_index, hold_s)[1:]
-    _, tip_y = st.force(q)
-    return Equilibrium(q=q, contact_set=set_index, lambda_n=lambda_n, lambda_t=float(lambda_t),
-                       friction_held=bool(friction or not hold_s), tip_y=float(tip_y),
-                       residual=float(np.max(np.abs(Q[coords]))) if coords else 0.0)
+    eq = Equilibrium(q=q, contact_set=set_index, lambda_n=lambda_n, lambda_t=float(lambda_t),
+                     friction_held=bool(friction or not hold_s), tip_y=float(tip_y),
+                     residual=float(np.max(np.abs(Q[coords]))) if coords.size else 0.0)
+    return eq, potential
 
 
 def static_equilibrium(p: Parameters, tip_load_n: float = 0.0, fixed=(), s0: float = 0.0,
@@ -229,10 +161,10 @@ def _solve_equilibrium(p, tip_load_n, fixed, s0, q_guess):
     for hold_s in (True, False):
         found = [e for e in (_solve_set(st, guess, k, hold_s) for k in sets) if e is not None]
         if found:
+            best, _ = min(found, key=lambda e: e[1])
             if not hold_s:
-                for e in found:
-                    e.friction_held = False
-            return min(found, key=lambda e: st.potential(e.q))
+                best.friction_held = False
+            return best
     raise ParameterError("no static equilibrium found in any contact set "
                          f"(tip load {tip_load_n} N); check gap, h4 and the loads")
 
