@@ -16,7 +16,8 @@ user's machine, Python writes its bytecode cache (an inherited
 marks around the imports, the model's check (the first kernel load, which
 brings numba's registries), the static start, loading ``run_hybrid``, the run
 and the summary.  The process entry point's collector settings
-(``cli.entry``) are applied; its exit is not timed.
+(``cli.entry``) are applied; its exit is not timed.  Run this copy with an
+older checkout's interpreter to see that checkout's phases.
 """
 from __future__ import annotations
 
@@ -67,7 +68,8 @@ def phases() -> None:
     import workbench.experiments.files                         # noqa: F401
     import workbench.experiments.matching                      # noqa: F401
     mark("import workbench")
-    gc.set_threshold(cli.GC_THRESHOLD)
+    if hasattr(cli, "GC_THRESHOLD"):                            # older checkouts: the default
+        gc.set_threshold(cli.GC_THRESHOLD)
 
     def timed(owner, name, label, before="other Python"):
         inner = getattr(owner, name)
