@@ -197,7 +197,10 @@ def slow_lcp_solutions(G, u, mu, m):
 
 
 @st.composite
-def impact_problems(draw):
+def impact_problems(draw, physical_rates=True):
+    """(G, u, mu, m) of random contact rows W and mass matrix M: G = W M^-1 W^T; u the rates
+    W q' of a velocity q' (as in a run), or with ``physical_rates=False`` drawn freely (then
+    possibly outside G's range when G is singular, where no kinetic energy is defined)."""
     m = draw(st.sampled_from([1, 2]))
     ndof = draw(st.sampled_from([3, 5]))
     rows = np.array(draw(st.lists(st.floats(-2, 2, allow_subnormal=False), min_size=2 * m * ndof,
@@ -218,8 +221,13 @@ def impact_problems(draw):
                                  max_size=ndof * ndof))).reshape(ndof, ndof)
     M = np.diag(diag) + mix @ mix.T
     G = W @ np.linalg.inv(M) @ W.T
-    u = np.array(draw(st.lists(st.floats(-3, 3, allow_subnormal=False), min_size=2 * m,
-                               max_size=2 * m)))
+    if physical_rates:
+        qd = np.array(draw(st.lists(st.floats(-3, 3, allow_subnormal=False), min_size=ndof,
+                                    max_size=ndof)))
+        u = W @ qd
+    else:
+        u = np.array(draw(st.lists(st.floats(-3, 3, allow_subnormal=False), min_size=2 * m,
+                                   max_size=2 * m)))
     mu = np.array(draw(st.lists(st.floats(0.0, 1.2), min_size=m, max_size=m)))
     return G, u, mu, m
 
@@ -229,28 +237,19 @@ def impact_problems(draw):
 @example((np.array([[2.0, 0.0, 4.0, 0.0], [0.0, 0.0, 0.0, 0.0], [4.0, 0.0, 9.0, 0.0],
                     [0.0, 0.0, 0.0, 4.0]]), np.array([0.0, 0.0, 0.0, 5.96046448e-08]),
           np.array([0.0, 0.0]), 2))
-# point 2's tangential row equals its normal row (G's block [[1, 1], [1, 1]]) and mu = 1: the
-# velocity-level Painleve paradox, no impulse satisfies the law (P_n = 1 / (1 - mu) for mu < 1)
-@example((np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.0],
-                    [0.0, 0.0, 1.0, 1.0]]), np.array([0.0, 0.0, -1.0, 0.0]),
-          np.array([0.0, 1.0]), 2))
 def test_random_delassus_against_slow_lcp(problem):
-    """The law finds the most dissipative solution whenever the exhaustive solve finds one,
-    and reports NOT_FOUND (P = 0) when there is none.  With G only semi-definite there can be
-    none: a point whose tangential row is parallel to its normal row under M^-1 (a body held
-    so that it can only turn) and G_nn <= mu |G_nt| cannot be stopped by any impulse in the
-    friction cone."""
+    """Rates of a velocity: the law finds a solution, every condition holds, the kinetic energy
+    does not rise, and of the solutions the exhaustive solve finds it is the most dissipative."""
     G, u, mu, m = problem
     source, P, _ = eval_impact(G, u, mu, m)
-    slow = slow_lcp_solutions(G, u, mu, m)
-    if not slow:
-        assert source == NOT_FOUND and np.all(P == 0.0)
-        return
     assert source != NOT_FOUND
     check_conditions(G, u, mu, m, P, tol=1e-6)
     de = energy_change(G, u, P, m)
     scale = max(1e-12, float(np.abs(u).max() ** 2 / max(np.abs(np.diag(G)).max(), 1e-12)))
     assert de <= 1e-9 * scale                                  # kinetic energy never rises
+    slow = slow_lcp_solutions(G, u, mu, m)
+    if not slow:            # the exhaustive solve skips bases with a null space of dimension 2
+        return
     slow_de = min(energy_change(G, u, p, m) for p in slow)
     # the most dissipative one; the slow solve's least squares leave round-off of
     # the size eps |G| |P|^2 in its energies (4e-16 where u is 6e-8 and scale 1e-12)
@@ -258,8 +257,53 @@ def test_random_delassus_against_slow_lcp(problem):
     assert de == pytest.approx(slow_de, abs=1e-6 * scale + roundoff)
 
 
+@settings(max_examples=60, deadline=None)
+@given(impact_problems(physical_rates=False))
+# point 2's tangential row equals its normal row (G's block [[1, 1], [1, 1]]), its rates
+# (-1, 0) are outside G's range and mu = 1: no impulse satisfies the law (P_n = 1 / (1 - mu)
+# for mu < 1)
+@example((np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.0],
+                    [0.0, 0.0, 1.0, 1.0]]), np.array([0.0, 0.0, -1.0, 0.0]),
+          np.array([0.0, 1.0]), 2))
+# a flat double contact (equal tangential rows) whose tangential rates differ: along G's null
+# direction P^T u + P^T G P / 2 is unbounded below, so no energy is compared here
+@example((np.array([[1.0000001442248299, 1.0, 0.0, 1.0], [1.0, 2.0, 1.0, 2.0],
+                    [0.0, 1.0, 1.0, 1.0], [1.0, 2.0, 1.0, 2.0]]), np.array([0.0, 0.0, 0.0, 1.0]),
+          np.array([0.0, 1.0]), 2))
+@example((np.ones((2, 2)), np.array([-3.74769908797976e-61, 0.0]), np.array([1.0]), 1))
+def test_rates_outside_the_range_of_G(problem):
+    """Rates no velocity has (outside G's range where G is singular; not in a run): whatever
+    the law returns satisfies every condition, and NOT_FOUND (P = 0) only where the exhaustive
+    solve finds no solution either (a point whose tangential row is parallel to its normal row
+    under M^-1 with G_nn <= mu |G_nt| can have none)."""
+    G, u, mu, m = problem
+    source, P, _ = eval_impact(G, u, mu, m)
+    if source == NOT_FOUND:
+        # the law is homogeneous in u: posed at max |u| = 1, the exhaustive solve's
+        # tolerances are relative to the rates (u = -3.7e-61 is an approach, not round-off)
+        assert np.all(P == 0.0) and np.abs(u).max() > 0.0
+        assert not slow_lcp_solutions(G, u / np.abs(u).max(), mu, m)
+    else:
+        check_conditions(G, u, mu, m, P, tol=1e-6)
+
+
+@pytest.mark.xfail(strict=True, reason="not solved: in a flat double contact whose rows have "
+                   "rank 2 the law's impulse runs along G's null space (P_n1 = 7.5e7 for rates "
+                   "of 0.75), which leaves the velocities right to round-off but not the impulses")
+def test_a_rank_two_flat_double_contact_gets_bounded_impulses():
+    """Rates of a velocity (u = W q') against a flat double contact of rank 2 (found by
+    hypothesis): the velocities stop, and the impulses should stay of the size u / |G|."""
+    G = np.array([[0.011962890625, 0.109375, 0.109375, 0.109375], [0.109375, 1.0, 1.0, 1.0],
+                  [0.109375, 1.0, 1.5625, 1.0], [0.109375, 1.0, 1.0, 1.0]])
+    u = np.array([0.0, 0.0, -0.75, 0.0])
+    source, P, _ = eval_impact(G, u, np.array([1.0, 0.0]), 2)
+    assert source != NOT_FOUND
+    assert np.abs(u + G @ P).max() < 1e-8
+    assert np.abs(P).max() < 1e3
+
+
 @settings(max_examples=40, deadline=None)
-@given(impact_problems())
+@given(impact_problems(physical_rates=False))
 # rates at round-off scale: ties of the ratio test are relative to q's scale
 @example((np.eye(2), np.array([0.0, 2.220446049250313e-16]), np.array([0.0]), 1))
 @example((np.ones((2, 2)), np.array([0.0, 2.220446049250313e-16]), np.array([0.0]), 1))
