@@ -1,8 +1,7 @@
 """Shared fixtures: parameter sets and random states within physical ranges."""
+import os
 import sys
 from pathlib import Path
-
-import os
 
 import numpy as np
 import pytest
