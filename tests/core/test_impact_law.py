@@ -232,6 +232,14 @@ def impact_problems(draw, physical_rates=True):
     return G, u, mu, m
 
 
+def _satisfies(G, u, mu, m, P, tol):
+    try:
+        check_conditions(G, u, mu, m, P, tol=tol)
+    except AssertionError:
+        return False
+    return True
+
+
 @settings(max_examples=60, deadline=None)
 @given(impact_problems())
 @example((np.array([[2.0, 0.0, 4.0, 0.0], [0.0, 0.0, 0.0, 0.0], [4.0, 0.0, 9.0, 0.0],
@@ -239,22 +247,27 @@ def impact_problems(draw, physical_rates=True):
           np.array([0.0, 0.0]), 2))
 def test_random_delassus_against_slow_lcp(problem):
     """Rates of a velocity: the law finds a solution, every condition holds, the kinetic energy
-    does not rise, and of the solutions the exhaustive solve finds it is the most dissipative."""
+    neither rises nor falls by more than the contacts' share of it (1/2 u^T G^+ u), and it is
+    at least as dissipative as every solution of the exhaustive solve that satisfies the law's
+    conditions to 1e-9 (that solve skips bases with a null space of dimension 2, so the law
+    may find a more dissipative one)."""
     G, u, mu, m = problem
     source, P, _ = eval_impact(G, u, mu, m)
     assert source != NOT_FOUND
     check_conditions(G, u, mu, m, P, tol=1e-6)
     de = energy_change(G, u, P, m)
     scale = max(1e-12, float(np.abs(u).max() ** 2 / max(np.abs(np.diag(G)).max(), 1e-12)))
+    slow = [p for p in slow_lcp_solutions(G, u, mu, m) if _satisfies(G, u, mu, m, p, 1e-9)]
+    # the slow solve's least squares leave round-off of the size eps |G| |P|^2 in its energies
+    # (4e-16 where u is 6e-8 and scale 1e-12)
+    roundoff = 1e-14 * (1.0 + max(np.abs(G).max() * float(np.abs(p).max()) ** 2
+                                  for p in [P, *slow]))
+    tol = 1e-6 * scale + roundoff
     assert de <= 1e-9 * scale                                  # kinetic energy never rises
-    slow = slow_lcp_solutions(G, u, mu, m)
-    if not slow:            # the exhaustive solve skips bases with a null space of dimension 2
-        return
-    slow_de = min(energy_change(G, u, p, m) for p in slow)
-    # the most dissipative one; the slow solve's least squares leave round-off of
-    # the size eps |G| |P|^2 in its energies (4e-16 where u is 6e-8 and scale 1e-12)
-    roundoff = 1e-14 * (1.0 + max(np.abs(G).max() * float(np.abs(p).max()) ** 2 for p in slow))
-    assert de == pytest.approx(slow_de, abs=1e-6 * scale + roundoff)
+    visible = 0.5 * u @ np.linalg.pinv(G, rcond=1e-13, hermitian=True) @ u
+    assert de >= -visible - tol                                # nor falls below zero
+    if slow:
+        assert de <= min(energy_change(G, u, p, m) for p in slow) + tol
 
 
 @settings(max_examples=60, deadline=None)
