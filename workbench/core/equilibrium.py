@@ -28,7 +28,7 @@ from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .contact import fill_geometry
 from .dynamics import add_applied_forces, assemble_inertia, cork_energy
-from .kinematics import compute_frames, element, n_elements
+from .kinematics import element, n_elements
 
 #: Scales of the residual's rows: forces (dyn) and gaps (cm).
 FORCE_SCALE = 1e5
@@ -58,8 +58,8 @@ def _residual(z, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec
     add_applied_forces(0.0, q, qd, P, tab, kc, ex, rec, vec)
     for i in range(ly.N_DOF):
         Q[i] = vec[ly.VEC_Q, i] - vec[ly.VEC_H, i]
-    compute_frames(q, qd, P, tab, rec)
-    element(n_elements(P) - 1, q, qd, P, tab, rec)      # the last element: the tip point
+    # the frames are assemble_inertia's: the last element is the tip point
+    element(n_elements(P) - 1, q, qd, P, tab, rec)
     tip = rec[ly.REC_POINT]
     for i in range(ly.N_DOF):
         Q[i] += tip_load * tip[ly.JY + i]

@@ -32,6 +32,9 @@ from .config import JIT, JIT_INLINE, LAW_RANK_TOL, LAW_REL_TOL
 from . import layout as ly
 
 OPEN, STICK, SLIP_POS, SLIP_NEG = 0, 1, 2, 3
+#: A condition's slope along the null direction below this fraction of the sum
+#: of its terms' magnitudes is round-off (4 terms of a few ulps each, with margin).
+SLOPE_ROUND_OFF = 1e-12
 #: Solution sources returned by :func:`solve_impact`.
 FOUND_ENUMERATION, FOUND_LEMKE, NOT_FOUND = 1, 2, 0
 
@@ -125,18 +128,19 @@ def _combo_impulse(G, u, mu, m, modes, lw, P):
         n = 2 * i
         t = n + 1
         if modes[i] == OPEN:
-            un0, un1 = _rate(G, u, P0, dP, m, n)
-            lo, hi = _clip(un0 + tol_u, un1, lo, hi)
+            un0, un1, un1_abs = _rate(G, u, P0, dP, m, n)
+            lo, hi = _clip(un0 + tol_u, un1, un1_abs, lo, hi)
             continue
-        lo, hi = _clip(P0[n] + tol_p, dP[n], lo, hi)
+        lo, hi = _clip(P0[n] + tol_p, dP[n], abs(dP[n]), lo, hi)
         if modes[i] == STICK:
             # |P_t| <= mu P_n: mu P_n - P_t >= 0 and mu P_n + P_t >= 0
-            lo, hi = _clip(mu[i] * P0[n] - P0[t] + tol_p, mu[i] * dP[n] - dP[t], lo, hi)
-            lo, hi = _clip(mu[i] * P0[n] + P0[t] + tol_p, mu[i] * dP[n] + dP[t], lo, hi)
+            d_abs = mu[i] * abs(dP[n]) + abs(dP[t])
+            lo, hi = _clip(mu[i] * P0[n] - P0[t] + tol_p, mu[i] * dP[n] - dP[t], d_abs, lo, hi)
+            lo, hi = _clip(mu[i] * P0[n] + P0[t] + tol_p, mu[i] * dP[n] + dP[t], d_abs, lo, hi)
         else:
-            ut0, ut1 = _rate(G, u, P0, dP, m, t)
+            ut0, ut1, ut1_abs = _rate(G, u, P0, dP, m, t)
             s = _sigma(modes[i])
-            lo, hi = _clip(s * ut0 + tol_u, s * ut1, lo, hi)
+            lo, hi = _clip(s * ut0 + tol_u, s * ut1, ut1_abs, lo, hi)
     if lo > hi:
         return False
     alpha = 0.0
@@ -153,20 +157,28 @@ def _combo_impulse(G, u, mu, m, modes, lw, P):
 
 @nb.njit(**JIT_INLINE)
 def _rate(G, u, P0, dP, m, r):
-    """Row r of u + G P(alpha) as (value at alpha = 0, slope)."""
+    """Row r of u + G P(alpha) as (value at alpha = 0, slope, sum of the slope's |terms|)."""
     a0 = u[r]
     a1 = 0.0
+    a1_abs = 0.0
     for c in range(2 * m):
         a0 += G[r, c] * P0[c]
         a1 += G[r, c] * dP[c]
-    return a0, a1
+        a1_abs += abs(G[r, c] * dP[c])
+    return a0, a1, a1_abs
 
 
 @nb.njit(**JIT_INLINE)
-def _clip(c, d, lo, hi):
-    """Intersect [lo, hi] with {alpha: c + d alpha >= 0}."""
+def _clip(c, d, d_abs, lo, hi):
+    """Intersect [lo, hi] with {alpha: c + d alpha >= 0}.
+
+    d_abs is the sum of the magnitudes of the terms that make up the slope
+    d: a slope within SLOPE_ROUND_OFF of it is round-off of a row that does
+    not change along the null direction, and counts as zero (its ratio -c/d
+    would be an arbitrary bound).
+    """
     scale = abs(c) + 1e-300
-    if abs(d) <= 1e-13 * scale:
+    if abs(d) <= 1e-13 * scale or abs(d) <= SLOPE_ROUND_OFF * d_abs:
         if c < 0.0:
             return 1.0, -1.0
         return lo, hi
