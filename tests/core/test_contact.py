@@ -65,3 +65,37 @@ def test_gaps_at_rest_and_rocking_closure():
         np.testing.assert_allclose(cg[ly.CG_T + 2, ly.CG_VAL], -local3[0], atol=1e-13)
         corner1 = origin + R @ np.array([0.0, -p.h4 / 2])
         np.testing.assert_allclose(cg[ly.CG_G + 0, ly.CG_VAL], corner1[1] + H, atol=1e-13)
+
+
+def test_two_point_contacts_have_rows_of_rank_three():
+    """Every two-point contact the model can reach, over the slot's whole travel: the rows
+    (n_i, t_i, n_j, t_j) on (s, v, psi) keep rank 3, so Moreau's law meets at most a
+    one-dimensional null space of G there (rank 2 would need s = x_lip - x_in, beyond
+    the travel).  Points 1 and 2 never close together: g1 + g2 = gap + h4 (1 - cos psi) > 0."""
+    from scipy.optimize import brentq
+
+    P = mdl.pack(Parameters())
+    travel = P[ly.P_S_TRAVEL]
+    smallest = {}
+    for i, j in ((0, 2), (0, 3), (1, 2), (1, 3)):
+        for s in np.linspace(-travel, travel, 9):
+            # close point i at each tilt psi (its gap is linear in v), then find the tilt
+            # that closes point j too
+            def state(psi):
+                q = np.zeros(ly.N_DOF)
+                q[ly.S], q[ly.PSI] = s, psi
+                cg = _geom(P, q)
+                q[ly.V] -= cg[ly.CG_G + i, ly.CG_VAL] / cg[ly.CG_G + i, ly.CG_DV]
+                return q
+
+            def gap_j(psi):
+                return _geom(P, state(psi))[ly.CG_G + j, ly.CG_VAL]
+
+            psi = brentq(gap_j, -0.2, 0.2, xtol=1e-15)
+            cg = _geom(P, state(psi))
+            assert abs(cg[ly.CG_G + i, ly.CG_VAL]) < 1e-12 and abs(cg[ly.CG_G + j, ly.CG_VAL]) < 1e-12
+            assert cg[ly.CG_G:ly.CG_G + ly.N_POINTS, ly.CG_VAL].min() > -1e-12
+            W = cg[[ly.CG_G + i, ly.CG_T + i, ly.CG_G + j, ly.CG_T + j]][:, list(COLS)]
+            sv = np.linalg.svd(W, compute_uv=False)
+            smallest[(i, j)] = min(smallest.get((i, j), np.inf), sv[2] / sv[0])
+    assert min(smallest.values()) > 0.1, smallest

@@ -325,7 +325,18 @@ def test_a_rank_two_flat_double_contact_gets_bounded_impulses():
 # rates at round-off scale: ties of the ratio test are relative to q's scale
 @example((np.eye(2), np.array([0.0, 2.220446049250313e-16]), np.array([0.0]), 1))
 @example((np.ones((2, 2)), np.array([0.0, 2.220446049250313e-16]), np.array([0.0]), 1))
+# flat double contacts with a nearly singular G: pivoting ended on bases of round-off values
+# (impulses of 1e5 off the friction cone's edge,
+# a closed point left approaching); such a result is now rejected
+@example((np.array([[1.0000152587890625, -1.0, 0.0, -1.0], [-1.0, 2.125, -0.75, 2.125],
+                    [0.0, -0.75, 0.5, -0.75], [-1.0, 2.125, -0.75, 2.125]]),
+          np.array([0.0, 0.0, -1.0, 0.0]), np.array([1.0, 1.0]), 2))
+@example((np.array([[1.000244140625, -1.0, 0.0, -1.0], [-1.0, 2.125, -0.75, 2.125],
+                    [0.0, -0.75, 0.5, -0.75], [-1.0, 2.125, -0.75, 2.125]]),
+          np.array([0.0, 0.0, -1.0, 0.0]), np.array([1.0, 0.0]), 2))
 def test_lemke_fallback_solves_the_same_lcp(problem):
+    """Whatever Lemke's method returns as a solution satisfies the law (it may also give up:
+    it is the fallback of the enumeration)."""
     G, u, mu, m = problem
     lw = np.zeros((ly.N_LAW, ly.N_LAW_COLS))
     P = np.zeros(2 * m)

@@ -23,8 +23,11 @@ direction so that every condition holds, if any choice does (the two rows
 handled as one).  If no combination is consistent (round-off at a
 degenerate state), the same problem posed as the standard linear
 complementarity problem (Stewart & Trinkle 1996; per point P_n, beta+,
-beta-, and the slip speed) is solved by Lemke's complementary pivoting.
+beta-, and the slip speed) is solved by Lemke's complementary pivoting, whose
+result is kept only if it satisfies the law to LEMKE_CHECK_TOL.
 """
+import math
+
 import numba as nb
 import numpy as np
 
@@ -35,6 +38,8 @@ OPEN, STICK, SLIP_POS, SLIP_NEG = 0, 1, 2, 3
 #: A condition's slope along the null direction below this fraction of the sum
 #: of its terms' magnitudes is round-off (4 terms of a few ulps each, with margin).
 SLOPE_ROUND_OFF = 1e-12
+#: Lemke's result must satisfy the law to this fraction of the rates' and impulses' scales.
+LEMKE_CHECK_TOL = 1e-6
 #: Solution sources returned by :func:`solve_impact`.
 FOUND_ENUMERATION, FOUND_LEMKE, NOT_FOUND = 1, 2, 0
 
@@ -355,7 +360,8 @@ def lemke_impact(G, u, mu, m, lw, P):
     Per point z = (P_n, beta+, beta-, s) with P_t = beta+ - beta-:
     w = (u_n+, u_t+ + s, -u_t+ + s, mu P_n - beta+ - beta-).  The tableau
     (4m rows, 8m + 2 columns) lives in lw rows 14.. .  Returns True if a
-    solution was found (P written).
+    solution was found and it satisfies the law (:func:`satisfies_law`);
+    else P = 0.
     """
     n = 4 * m
     T = lw[14:14 + n]
@@ -443,6 +449,48 @@ def lemke_impact(G, u, mu, m, lw, P):
                 P[2 * pt + 1] += val
             elif which == 2:
                 P[2 * pt + 1] -= val
+    if satisfies_law(G, u, mu, m, P, LEMKE_CHECK_TOL):
+        return True
+    for i in range(2 * m):
+        P[i] = 0.0
+    return False
+
+
+@nb.njit(**JIT)
+def satisfies_law(G, u, mu, m, P, tol):
+    """Whether impulses P satisfy Moreau's law at every point, to tol of the scales.
+
+    Rates are compared with tol max|u-|, impulses with tol times the larger
+    of max|P| and max|u-| / max G_ii.  Lemke's pivoting on a nearly
+    singular G can end on a basis whose values are round-off (impulses of
+    1e10 that open a closed point): its result is kept only if it passes.
+    """
+    scale_u = 1e-300
+    g_diag = 1e-300
+    scale_p = 0.0
+    for r in range(2 * m):
+        scale_u = max(scale_u, abs(u[r]))
+        g_diag = max(g_diag, abs(G[r, r]))
+        scale_p = max(scale_p, abs(P[r]))
+    scale_p = max(scale_p, scale_u / g_diag)
+    for i in range(m):
+        n = 2 * i
+        t = n + 1
+        un = u[n]
+        ut = u[t]
+        for c in range(2 * m):
+            un += G[n, c] * P[c]
+            ut += G[t, c] * P[c]
+        pn = P[n]
+        pt = P[t]
+        if pn < -tol * scale_p or un < -tol * scale_u:
+            return False
+        if abs(pn * un) > tol * scale_p * scale_u:
+            return False
+        if abs(pt) > mu[i] * pn + tol * scale_p:
+            return False
+        if abs(ut) > tol * scale_u and abs(pt + math.copysign(mu[i] * pn, ut)) > tol * scale_p:
+            return False
     return True
 
 
