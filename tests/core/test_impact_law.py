@@ -325,9 +325,9 @@ def test_a_rank_two_flat_double_contact_gets_bounded_impulses():
 # rates at round-off scale: ties of the ratio test are relative to q's scale
 @example((np.eye(2), np.array([0.0, 2.220446049250313e-16]), np.array([0.0]), 1))
 @example((np.ones((2, 2)), np.array([0.0, 2.220446049250313e-16]), np.array([0.0]), 1))
-# flat double contacts with a nearly singular G: pivoting ended on bases of round-off values
-# (impulses of 1e5 off the friction cone's edge,
-# a closed point left approaching); such a result is now rejected
+# flat double contacts with a nearly singular G: pivoting can end on a basis of round-off
+# values (impulses of 1e5 off the friction cone's edge, a closed point left approaching),
+# which the law rejects
 @example((np.array([[1.0000152587890625, -1.0, 0.0, -1.0], [-1.0, 2.125, -0.75, 2.125],
                     [0.0, -0.75, 0.5, -0.75], [-1.0, 2.125, -0.75, 2.125]]),
           np.array([0.0, 0.0, -1.0, 0.0]), np.array([1.0, 1.0]), 2))
