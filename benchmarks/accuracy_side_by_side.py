@@ -16,6 +16,9 @@ the events.  It uses only ``simulate``, so it runs in an older checkout too
 (put that checkout first on PYTHONPATH): both are then measured against the
 same converged solution, alternately, on the same machine.
 
+``windows ... --starts 2,3.5`` takes a window after each of those times (s) of
+every 10 s sine instead.
+
 ``measure ... --held u_A,u_B`` holds those coordinates at their values at the
 window's start (their rates zeroed): a reduced model measured against the
 converged full model.
@@ -94,19 +97,25 @@ def errors(tip, shares, ref_tip, ref_shares):
     return tip_err, float(share_err)
 
 
-def save_windows(path):
+def save_windows(path, starts=None):
+    """Each case's window after its own start; with ``starts`` (s), one window after each of
+    them for every 10 s sine (keys "case @start")."""
     out = {}
     for name, (params, ex, duration, after) in cases().items():
+        if starts is not None and not name.startswith("sine"):
+            continue
         run = simulate(params, ex, duration, output_hz=SAMPLE_HZ)
-        t0, y0, regime = _window_start(run, after)
-        _, tip, shares, n_events = window(params, ex, t0, y0, regime, CONVERGED_DT)
-        _, tip2, shares2, _ = window(params, ex, t0, y0, regime, CONVERGED_DT / 2)
-        own = errors(tip2, shares2, tip, shares)
-        out[name] = {"t0": t0, "y0": y0.tolist(), "regime": regime, "tip": tip.tolist(),
-                     "shares": {str(k): v for k, v in shares.items()}, "events": n_events,
-                     "converged_own_error": own}
-        print(json.dumps({"case": name, "t0": t0, "converged_events": n_events,
-                          "converged_own_error": own}), flush=True)
+        for start in (after,) if starts is None else starts:
+            t0, y0, regime = _window_start(run, start)
+            _, tip, shares, n_events = window(params, ex, t0, y0, regime, CONVERGED_DT)
+            _, tip2, shares2, _ = window(params, ex, t0, y0, regime, CONVERGED_DT / 2)
+            own = errors(tip2, shares2, tip, shares)
+            key = name if starts is None else f"{name} @{start:g}"
+            out[key] = {"case": name, "t0": t0, "y0": y0.tolist(), "regime": regime,
+                        "tip": tip.tolist(), "shares": {str(k): v for k, v in shares.items()},
+                        "events": n_events, "converged_own_error": own}
+            print(json.dumps({"case": key, "t0": t0, "converged_events": n_events,
+                              "converged_own_error": own}), flush=True)
     with open(path, "w") as f:
         json.dump(out, f)
 
@@ -114,8 +123,8 @@ def save_windows(path):
 def measure(path, steps, held=()):
     with open(path) as f:
         saved = json.load(f)
-    for name, (params, ex, _, _) in cases().items():
-        w = saved[name]
+    for name, w in saved.items():
+        params, ex, _, _ = cases()[w.get("case", name)]
         for dt in steps:
             walls = []
             try:
@@ -135,7 +144,10 @@ def measure(path, steps, held=()):
 
 if __name__ == "__main__":
     if sys.argv[1] == "windows":
-        save_windows(sys.argv[2])
+        starts = None
+        if "--starts" in sys.argv:
+            starts = [float(x) for x in sys.argv[sys.argv.index("--starts") + 1].split(",")]
+        save_windows(sys.argv[2], starts)
     else:
         args = sys.argv[3:]
         held = tuple(args[args.index("--held") + 1].split(",")) if "--held" in args else ()
