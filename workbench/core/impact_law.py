@@ -36,7 +36,8 @@ from . import layout as ly
 
 OPEN, STICK, SLIP_POS, SLIP_NEG = 0, 1, 2, 3
 #: A condition's slope along the null direction below this fraction of the sum
-#: of its terms' magnitudes is round-off (4 terms of a few ulps each, with margin).
+#: of its terms' magnitudes is round-off: of the at most 4 products and of the
+#: elimination that gave the direction (about 4500 ulps).
 SLOPE_ROUND_OFF = 1e-12
 #: Lemke's result must satisfy the law to this fraction of the rates' and impulses' scales.
 LEMKE_CHECK_TOL = 1e-6
@@ -463,7 +464,8 @@ def satisfies_law(G, u, mu, m, P, tol):
     Rates are compared with tol max|u-|, impulses with tol times the larger
     of max|P| and max|u-| / max G_ii.  Lemke's pivoting on a nearly
     singular G can end on a basis whose values are round-off (impulses of
-    1e10 that open a closed point): its result is kept only if it passes.
+    1e5 off the friction cone's edge, a closed point left approaching): its
+    result is kept only if it passes.
     """
     scale_u = 1e-300
     g_diag = 1e-300
