@@ -123,8 +123,9 @@ def save_windows(path, starts=None):
 def measure(path, steps, held=()):
     with open(path) as f:
         saved = json.load(f)
+    known = cases()
     for name, w in saved.items():
-        params, ex, _, _ = cases()[w.get("case", name)]
+        params, ex, _, _ = known[w.get("case", name)]
         for dt in steps:
             walls = []
             try:

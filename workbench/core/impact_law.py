@@ -332,6 +332,18 @@ def solve_impact(G, u, mu, m, lw, P, modes):
     return NOT_FOUND
 
 
+@nb.njit(**JIT_INLINE)
+def _post_rates(G, u, P, m, i):
+    """Point i's post-impact normal and tangential rates (u + G P)_n, (u + G P)_t (cm/s)."""
+    n = 2 * i
+    un = u[n]
+    ut = u[n + 1]
+    for c in range(2 * m):
+        un += G[n, c] * P[c]
+        ut += G[n + 1, c] * P[c]
+    return un, ut
+
+
 @nb.njit(**JIT)
 def classify(G, u, P, m, modes):
     """Modes of a solution P: open if P_n is negligible and the point leaves, else stick or slip."""
@@ -340,12 +352,7 @@ def classify(G, u, P, m, modes):
         u_scale = max(u_scale, abs(u[r]))
     tol = 1e-7 * u_scale + 1e-300
     for i in range(m):
-        n = 2 * i
-        un = u[n]
-        ut = u[n + 1]
-        for c in range(2 * m):
-            un += G[n, c] * P[c]
-            ut += G[n + 1, c] * P[c]
+        un, ut = _post_rates(G, u, P, m, i)
         if un > tol:
             modes[i] = OPEN
         elif abs(ut) <= tol:
@@ -476,15 +483,9 @@ def satisfies_law(G, u, mu, m, P, tol):
         scale_p = max(scale_p, abs(P[r]))
     scale_p = max(scale_p, scale_u / g_diag)
     for i in range(m):
-        n = 2 * i
-        t = n + 1
-        un = u[n]
-        ut = u[t]
-        for c in range(2 * m):
-            un += G[n, c] * P[c]
-            ut += G[t, c] * P[c]
-        pn = P[n]
-        pt = P[t]
+        un, ut = _post_rates(G, u, P, m, i)
+        pn = P[2 * i]
+        pt = P[2 * i + 1]
         if pn < -tol * scale_p or un < -tol * scale_u:
             return False
         if abs(pn * un) > tol * scale_p * scale_u:
