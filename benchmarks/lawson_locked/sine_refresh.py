@@ -12,14 +12,14 @@ events, Lawson steps and operators of each.
 """
 import statistics
 import sys
+from pathlib import Path
 
-from workbench.model.excitation import sine
-from workbench.model.params import Parameters
-from workbench.model.simulate import simulate
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from accuracy_side_by_side import cases  # noqa: E402
 
-tip = sys.argv[1] == "tip"
-p = Parameters().replace(gap_mm=1.016, cork="cubic", tip_mass=tip)
-ex = sine(200.0, 20.0, ramp_s=1.0)
+from workbench.model.simulate import simulate  # noqa: E402
+
+p, ex, _, _ = cases()["sine tip 200 N" if sys.argv[1] == "tip" else "sine no tip 200 N"]
 simulate(p, ex, 0.01)
 configs = [("RK4", dict(lawson_locked=False))] + [
     (f"L every {m}", dict(lawson_refresh=m)) for m in (1, 4, 16)] + [
