@@ -1,9 +1,9 @@
 """Five more 0.25 s windows, where the joint rocks hard, for ``accuracy_side_by_side``.
 
-    python benchmarks/ars343/hard_windows.py windows /tmp/hard.json [--set chatter]
-    python benchmarks/ars343/hard_windows.py measure /tmp/hard.json 1e-4 6.25e-5
+    python benchmarks/more_windows.py windows /tmp/hard.json [--set chatter]
+    python benchmarks/more_windows.py measure /tmp/hard.json 1e-4 6.25e-5
     WORKBENCH_METHOD=ars343 PYTHONPATH=/path/to/patched/worktree \\
-        python benchmarks/ars343/hard_windows.py measure /tmp/hard.json 2.5e-4
+        python benchmarks/more_windows.py measure /tmp/hard.json 2.5e-4
 
 The same windows, converged solution and errors as
 ``benchmarks/accuracy_side_by_side.py`` (its functions, with these cases):
@@ -16,7 +16,7 @@ the no-tip 100 N, 55 Hz one instead.  ``WORKBENCH_METHOD`` is read by the patche
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy_side_by_side as acc  # noqa: E402
 
 from workbench.model.excitation import sine  # noqa: E402
