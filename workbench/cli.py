@@ -252,6 +252,7 @@ def _run_drive(args) -> dict:
 
 #: The run options behind the names of :func:`workbench.model.simulate.check_settings`.
 RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--output-hz",
+                    "method": "--method", "tol": "--tol",
                     "freq_hz": "--freq-hz", "f0_hz": "--chirp F0", "f1_hz": "--chirp F1",
                     "width_s": "--pulse-s", "t_hit_s": "--hit-s", "ramp_s": "--ramp-s"}
 
@@ -260,7 +261,7 @@ def _cmd_run(args) -> int:
     from .experiments import files
     from .experiments.matching import settings_of
     from .model import drives
-    from .model.simulate import check_settings, simulate
+    from .model.simulate import check_method, check_settings, simulate
     n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse,
                                            args.drive))
     if n_drives > 1:
@@ -274,12 +275,13 @@ def _cmd_run(args) -> int:
         names.update({key: f"--drive-set {key}" for key in drive if key != "kind"})
     ex = drives.excitation_array(drive)
     check_settings(p, ex, args.duration, args.dt, args.output_hz, names=names)
+    check_method(args.method, args.tol, dt_given=args.dt is not None, names=names)
     if args.out:
         check_output_file("--out", args.out, files.SUFFIXES)
         meta = settings_of(drive, p)
         files.check_settings(args.out, meta)
     run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
-                   initial=args.initial, progress=not args.json and sys.stderr.isatty(),
+                   method=args.method, tol=args.tol, initial=args.initial, progress=not args.json and sys.stderr.isatty(),
                    **drives.start_keywords(drive))
     if args.out:
         if files.format_of(args.out) == "parquet":       # the whole run: every signal, events
@@ -644,7 +646,15 @@ def build_parser() -> argparse.ArgumentParser:
     _add_drive_options(run, ramp_help=f"soft-start ramp of sine/chirp (s); default "
                                       f"{DEFAULT_RAMP_S:g} s, or half the run if shorter")
     run.add_argument("--duration", type=_number(0, MAX_DURATION_S, lo_open=True), default=1.0, help="simulated time (s)")
-    run.add_argument("--dt", type=_number(MIN_DT, MAX_DT), help="RK4 step (s); default from the model's fastest mode")
+    run.add_argument("--dt", type=_number(MIN_DT, MAX_DT),
+                     help="fixed RK4 step (s; implies --method rk4 unless --tol is given); default "
+                     "from the model's fastest mode")
+    run.add_argument("--method", default=None,
+                     help="integration method: controlled (default: steps chosen by the error "
+                     "against --tol) or rk4 (fixed steps of --dt)")
+    run.add_argument("--tol", type=_number(0, lo_open=True), default=None,
+                     help="relative tolerance of the controlled method (default 1e-4; "
+                     "docs/model.md 'Integration')")
     run.add_argument("--output-hz", type=_number(0, MAX_OUTPUT_HZ, lo_open=True), default=1000.0, help="sample rate of the signals")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")

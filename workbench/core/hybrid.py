@@ -506,9 +506,129 @@ def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, s
 
 
 @nb.njit(**JIT)
+def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, out_t, out_y,
+          out_sig, log, st):
+    """Start (or continue) a run at t from STAGE_CUR: the regime chosen, its events.
+
+    On a run's first call (step0 == 0) the start is logged and stored too.
+    Returns ``(status, n_stored, n_log)``.
+    """
+    y = stages[ly.STAGE_CUR]
+    n_log = 0
+    stored = 0
+    reg_start = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
+    if step0 == 0:
+        st[ly.ST_T_IMPACT] = -1e300
+        st[ly.ST_S_MIN] = y[ly.S]
+        st[ly.ST_S_MAX] = y[ly.S]
+    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+                           stages[ly.STAGE_K1], st, GAP_TOL)
+    if status != ly.OK:
+        return status, stored, n_log
+    event_values(y, P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
+    if step0 == 0:
+        _log(log, n_log, t, ly.KIND_START, reg_start,
+             regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
+        n_log += 1
+        status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
+                        out_t, out_y, out_sig)
+        if status != ly.OK:
+            return status, stored, n_log
+        stored += 1
+    return ly.OK, stored, n_log
+
+
+@nb.njit(**JIT)
+def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+            ev, log, n_log, st):
+    """One step of the lattice, from (t, STAGE_CUR) to t_end, with its events.
+
+    ``dt`` (s) is the lattice step (the accumulation rule counts in it);
+    ``stepped_left`` the Moreau-Jean steps still to take after an event
+    flood.  The event log must have room for MAX_EVENTS_PER_STEP + 2 rows
+    from n_log.  Returns ``(status, t, n_log, stepped_left)``; on success
+    t == t_end and STAGE_CUR, STAGE_K1 and the events' start rows are at t.
+    """
+    y = stages[ly.STAGE_CUR]
+    n_step_events = 0
+    if stepped_left > 0:
+        status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+                          ev, st)
+        if status != ly.OK:
+            st[ly.ST_T] = t
+            return status, t, n_log, stepped_left
+        stepped_left -= 1
+        t = t_end
+    while stepped_left == 0:
+        h = t_end - t
+        if h <= 1e-15 * dt:
+            break
+        e = _immediate_impact(ev)
+        if e < 0:
+            status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                              rg, stages[ly.STAGE_NEXT])
+            if status == ly.OK:
+                correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
+                st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
+                st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+                status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec,
+                                    mat, vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
+            if status != ly.OK:
+                return status, t, n_log, stepped_left
+            event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+            status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                      rg, ev)
+            if status != ly.OK:
+                return status, t, n_log, stepped_left
+            if e < 0:
+                _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+                _copy(stages, ly.STAGE_KNEXT, ly.STAGE_K1)
+                _copy_ev(ev, ly.EV_END, ly.EV_START)
+                for p in range(ly.N_POINTS):
+                    ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+                t = t_end
+                break
+            _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
+            t = t_end if theta >= 1.0 else t + theta * h
+            for p in range(ly.N_POINTS):       # penetration when the event is found
+                if not in_set(int(rg[ly.RG_SET]), p):
+                    _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t,
+                                 10 + p)
+        while e >= 0:
+            n_step_events += 1
+            if n_step_events > MAX_EVENTS_PER_STEP:
+                # an episode the event-driven logic cannot resolve: Moreau-Jean
+                # time-stepping through the rest of this step and STEPPED_STEPS more
+                status = ly.OK
+                if t_end - t > 1e-15 * dt:
+                    status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages,
+                                      cg, cw, rg, ev, st)
+                if status != ly.OK:
+                    st[ly.ST_T] = t
+                    return status, t, n_log, stepped_left
+                t = t_end
+                stepped_left = STEPPED_STEPS
+                break
+            status = apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                 rg, ev, log, n_log, st)
+            if status != ly.OK:
+                st[ly.ST_T] = t
+                return status, t, n_log, stepped_left
+            n_log += 1
+            e = _immediate_impact(ev)
+    for p in range(ly.N_POINTS):
+        if not in_set(int(rg[ly.RG_SET]), p):
+            _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p], t, 20 + p)
+    st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
+    st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
+    st[ly.ST_T] = t
+    return ly.OK, t, n_log, stepped_left
+
+
+@nb.njit(**JIT)
 def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat, vec, stages,
                cg, cw, rg, ev, out_t, out_y, out_sig, log, st):
-    """Integrate n_steps steps of dt (s) from (t0, y0) with contact events.
+    """Integrate n_steps fixed RK4 steps of dt (s) from (t0, y0) with contact events.
 
     y0 (N_AUG,) is the augmented state; rg holds the starting regime and,
     on return, the final one; STAGE_CUR holds the final state.  ``step0``
@@ -527,109 +647,22 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
     if (y0.shape[0] != ly.N_AUG or decim < 1 or n_out < need or out_y.shape[0] < need
             or out_sig.shape[0] < need or log.shape[0] < MAX_EVENTS_PER_STEP + 2):
         return ly.ERR_BAD_INPUT, 0, 0
-    y = stages[ly.STAGE_CUR]
     for i in range(ly.N_AUG):
-        y[i] = y0[i]
-    n_log = 0
-    stored = 0
-    t = t0
-    reg_start = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
-    if step0 == 0:
-        st[ly.ST_T_IMPACT] = -1e300
-        st[ly.ST_S_MIN] = y[ly.S]
-        st[ly.ST_S_MAX] = y[ly.S]
-    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-                           stages[ly.STAGE_K1], st, GAP_TOL)
+        stages[ly.STAGE_CUR, i] = y0[i]
+    status, stored, n_log = begin(t0, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                  rg, ev, out_t, out_y, out_sig, log, st)
     if status != ly.OK:
         return status, stored, n_log
-    event_values(y, P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
-    if step0 == 0:
-        _log(log, n_log, t, ly.KIND_START, reg_start,
-             regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
-        n_log += 1
-    if step0 == 0:
-        status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
-                        out_t, out_y, out_sig)
-        if status != ly.OK:
-            return status, stored, n_log
-        stored += 1
+    t = t0
     stepped_left = 0
     for step in range(1, n_steps + 1):
         if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
             return ly.LOG_FULL, stored, n_log
-        t_end = t0 + step * dt
-        n_step_events = 0
-        if stepped_left > 0:
-            status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-                              ev, st)
-            if status != ly.OK:
-                st[ly.ST_T] = t
-                return status, stored, n_log
-            stepped_left -= 1
-            t = t_end
-        while stepped_left == 0:
-            h = t_end - t
-            if h <= 1e-15 * dt:
-                break
-            e = _immediate_impact(ev)
-            if e < 0:
-                status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                  rg, stages[ly.STAGE_NEXT])
-                if status == ly.OK:
-                    correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
-                    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
-                    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
-                    status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec,
-                                        mat, vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
-                if status != ly.OK:
-                    return status, stored, n_log
-                event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-                status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                          rg, ev)
-                if status != ly.OK:
-                    return status, stored, n_log
-                if e < 0:
-                    _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
-                    _copy(stages, ly.STAGE_KNEXT, ly.STAGE_K1)
-                    _copy_ev(ev, ly.EV_END, ly.EV_START)
-                    for p in range(ly.N_POINTS):
-                        ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
-                    t = t_end
-                    break
-                _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
-                t = t_end if theta >= 1.0 else t + theta * h
-                for p in range(ly.N_POINTS):       # penetration when the event is found
-                    if not in_set(int(rg[ly.RG_SET]), p):
-                        _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t,
-                                     10 + p)
-            while e >= 0:
-                n_step_events += 1
-                if n_step_events > MAX_EVENTS_PER_STEP:
-                    # an episode the event-driven logic cannot resolve: Moreau-Jean
-                    # time-stepping through the rest of this step and STEPPED_STEPS more
-                    status = ly.OK
-                    if t_end - t > 1e-15 * dt:
-                        status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages,
-                                          cg, cw, rg, ev, st)
-                    if status != ly.OK:
-                        st[ly.ST_T] = t
-                        return status, stored, n_log
-                    t = t_end
-                    stepped_left = STEPPED_STEPS
-                    break
-                status = apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                     rg, ev, log, n_log, st)
-                if status != ly.OK:
-                    st[ly.ST_T] = t
-                    return status, stored, n_log
-                n_log += 1
-                e = _immediate_impact(ev)
-        for p in range(ly.N_POINTS):
-            if not in_set(int(rg[ly.RG_SET]), p):
-                _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p], t, 20 + p)
-        st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
-        st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
-        st[ly.ST_T] = t
+        status, t, n_log, stepped_left = advance(t, t0 + step * dt, dt, stepped_left, P, tab, kc,
+                                                 free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
+                                                 log, n_log, st)
+        if status != ly.OK:
+            return status, stored, n_log
         st[ly.ST_STEP] = step0 + step
         if (step0 + step) % decim == 0:
             status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,

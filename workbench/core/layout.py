@@ -258,6 +258,8 @@ EV_LAMBDA = EV_GAP + N_POINTS  # EV_LAMBDA + k: lambda_n of active point k (sepa
 EV_STICK = EV_LAMBDA + N_POINTS  # mu_s sum lambda_n - |lambda_t| (stick -> slip)
 EV_SLIP = EV_STICK + 1           # sigma tau' of the set's first point (slip -> stick)
 N_EV = EV_SLIP + 1
+EV_NAMES = ("gap1", "gap2", "gap3", "gap4", "lambda_n1", "lambda_n2", "lambda_n3", "lambda_n4",
+            "stick_margin", "slip_rate")
 
 # Event log (max_events, N_LOG)
 KIND_START, KIND_IMPACT, KIND_SEPARATION, KIND_STICK_SLIP, KIND_SLIP_STICK = 0, 1, 2, 3, 4
@@ -294,6 +296,43 @@ ST_MAX_CORRECTION = 17   # largest |g| of an active gap before its projection (c
 ST_T_MAX_PEN = 18    # time of the largest penetration (s)
 ST_PEN_WHERE = 19    # where it was found: 10 x (1 event bracket, 2 step end) + point (0..3)
 N_ST = 20
+
+# --- the error-controlled integration (workbench.core.controlled) --------------
+# Snapshots snap (N_SNAP, N_AUG): an interval's start and the end of its
+# coarse path, each SNAP_ROWS rows: the state, its k1, the events' start
+# values and gap rates, the regime record, the run statistics, and
+# (SNAP_MISC) the time and the Moreau-Jean steps left.
+SNAP_Y, SNAP_K1, SNAP_EV, SNAP_EVR, SNAP_RG, SNAP_ST, SNAP_MISC = range(7)
+SNAP_ROWS = 7
+SNAP_START = 0
+SNAP_COARSE = SNAP_ROWS
+N_SNAP = 2 * SNAP_ROWS
+# Controller record ctl (N_CTL,): its state between calls and its statistics.
+CTL_LEVEL = 0        # level k of the current pair: coarse steps dt / 2^k, fine dt / 2^(k+1)
+CTL_STEPS = 1        # lattice steps of the accepted (fine) paths
+CTL_WORK = 2         # lattice steps taken in all (coarse, fine and rejected paths)
+CTL_INTERVALS = 3    # control intervals accepted
+CTL_REJECTED = 4     # control intervals redone with a finer pair
+CTL_H_MIN = 5        # smallest accepted step (s)
+CTL_H_MAX = 6        # largest accepted step (s)
+CTL_ERR_MAX = 7      # largest error estimate of an accepted interval, over the tolerance
+CTL_T_ERR_MAX = 8    # the start of that interval (s)
+CTL_N_FLOOR = 9      # intervals accepted at the finest level above the tolerance
+CTL_F_SCALE = 10     # largest total normal contact force at an interval's end (dyn)
+CTL_ARG_ERR_MAX = 11     # what set CTL_ERR_MAX: a component of (q, q'), or N_STATE + an event
+CTL_REJECTED_EVENTS = 12  # rejections because the two paths' event sequences differed
+CTL_LEVELS = 13      # CTL_LEVELS + j: intervals accepted with fine steps dt / 2^j (j < N_CTL_LEVELS)
+N_CTL_LEVELS = 10
+N_CTL = CTL_LEVELS + N_CTL_LEVELS
+# Error scales scale (2, N_STATE): row SCALE_FLOOR the smallest scale of each
+# component of (q, q'), row SCALE_PEAK its largest |value| so far.
+SCALE_FLOOR, SCALE_PEAK = 0, 1
+N_SCALE_ROWS = 2
+# Intervals accepted at the floor floor_log (capacity, N_FLOOR): where, the
+# regimes at its ends, the events of its accepted path, and the estimate
+# over the tolerance (-1: the two paths' regime sequences differ).
+FL_T0, FL_T1, FL_FROM, FL_TO, FL_EVENTS, FL_ERR = range(6)
+N_FLOOR = 6
 
 # Signals stored at the output rate (out_sig columns), CGS units.
 SIGNALS = ("force1", "hammer", "strain1", "strain2", "accel1", "accel2", "accel3", "tip_y",

@@ -23,8 +23,9 @@ import numpy as np
 
 from . import packing as mdl
 from ..core import layout as ly
-from ..core.hybrid import run_hybrid
 from .excitation import none
+from .methods import (DEFAULT_LEVEL_MAX, DEFAULT_METHOD, DEFAULT_TOL, FLOOR_LOG_ROWS, METHODS,
+                      TOL_RANGE, segment_steps)
 from .limits import MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD
 from ..study.metrics import contact_shares_of
 from .params import ParameterError, Parameters, check_positive
@@ -198,6 +199,10 @@ CONTACT_STAT_KEYS = ("accumulations", "accumulation_energy_lost_erg", "inconsist
 
 _CHUNK_S = 1.0
 _LOG_ROWS = 8192
+#: The controlled method's log holds both paths of an interval at its finest level.
+_LOG_ROWS_CONTROLLED = 65536
+#: Intervals accepted at the finest level listed in :meth:`Run.summary` (all are in ``control``).
+SUMMARY_FLOOR_ROWS = 20
 
 Q_COLUMNS = list(ly.COORD_NAMES)
 QD_COLUMNS = [f"{n}_dot" for n in ly.COORD_NAMES]
@@ -246,6 +251,12 @@ class Run:
     units: dict = field(default_factory=dict)
     t0: float = 0.0
     compile_s: float = 0.0      # compiling or loading the kernel (not in wall_s)
+    method: str = "rk4"
+    tol: float | None = None    # the controlled method's relative tolerance
+    control: dict = field(default_factory=dict)   # steps, rejections, error estimate (summary())
+    method: str = "rk4"
+    tol: float | None = None    # the controlled method's relative tolerance
+    control: dict = field(default_factory=dict)   # steps, rejections, error estimate (summary())
 
     @property
     def ok(self) -> bool:
@@ -347,6 +358,10 @@ class Run:
             "wall_s": self.wall_s,
             "compile_s": self.compile_s,
             "dt": self.dt,
+            "method": self.method,
+            "tol": self.tol,
+            **{key: value for key, value in self.control.items() if key != "floor_intervals"},
+            "floor_intervals": self.control.get("floor_intervals", [])[:SUMMARY_FLOOR_ROWS],
             "initial": self.initial,
             "n_events": int((kinds != ly.KIND_START).sum()),
             "n_impacts": int((kinds == ly.KIND_IMPACT).sum()),
@@ -413,14 +428,20 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
 def simulate(params: Parameters, excitation: np.ndarray | None = None, duration: float = 1.0, *,
              dt: float | None = None, output_hz: float = DEFAULT_OUTPUT_HZ, initial="static",
              free_decay_cm: float | None = None, fixed=(), progress: bool = False,
-             t0: float = 0.0, regime: int = 0) -> Run:
+             t0: float = 0.0, regime: int = 0, method: str | None = None,
+             tol: float | None = None, level_max: int = DEFAULT_LEVEL_MAX) -> Run:
     """Simulate ``duration`` seconds of the loose-joint beam (docs/model.md §3-9).
 
     ``excitation`` is an array from :mod:`workbench.model.excitation` (default: none).
     ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
     excitation is evaluated at those times (e.g. to continue from a state
     of an earlier run, given as ``initial`` with its ``regime``).
-    ``dt`` is the RK4 step (s), by default :func:`default_dt`.
+    ``method`` (:mod:`workbench.model.methods`): "controlled" (the default)
+    chooses the steps by an error estimate against the relative tolerance
+    ``tol`` (default DEFAULT_TOL), down to dt / 2^level_max; "rk4" takes
+    fixed RK4 steps of dt, and is the default when ``dt`` is given without
+    ``tol``.  ``dt`` (s) is the fixed step, or the controlled method's
+    coarsest; by default :func:`default_dt`.
     ``output_hz`` is the sample rate of the signals; 1 / (output_hz dt)
     must be a whole number.  ``fixed`` holds coordinates (tests, locked
     joint).  Never raises on a failure of the integration: the run stops
@@ -429,10 +450,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if not isinstance(params, Parameters):
         raise ParameterError(f"params must be workbench.model.params.Parameters, got {type(params).__name__}")
     ex = none() if excitation is None else np.asarray(excitation, dtype=float)
+    dt_given = dt is not None
     if ex.shape != (ly.N_EXC,):
         raise ParameterError("excitation must come from workbench.model.excitation (an array of "
                              f"{ly.N_EXC} values)")
     dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, strict=False)
+    method, tol = check_method(method, tol, dt_given=dt_given)
     if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
         raise ParameterError("free_decay_cm releases the structure without excitation; "
                              "leave excitation unset")
@@ -450,6 +473,17 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     work.rg[ly.RG_SIGN] = 1.0
     st = np.zeros(ly.N_ST)
     chunk = max(decim, (round(_CHUNK_S / dt) // decim) * decim)
+    kernel = METHODS[method].kernel
+    if METHODS[method].controlled:
+        seg = segment_steps(decim, n_steps)
+        ctl = np.zeros(ly.N_CTL)
+        ctl[ly.CTL_H_MIN] = np.inf
+        controller = (np.zeros((ly.N_SNAP, ly.N_AUG)), ctl, np.zeros((ly.N_SCALE_ROWS, ly.N_STATE)),
+                      np.zeros((FLOOR_LOG_ROWS, ly.N_FLOOR)))
+        settings = (seg, tol, int(level_max))
+        log_rows = _LOG_ROWS_CONTROLLED
+    else:
+        controller, settings, log_rows = (), (), _LOG_ROWS
     parts_t, parts_y, parts_s, parts_log = [], [], [], []
     done = 0
     status = ly.OK
@@ -457,9 +491,10 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
-    compile_s = compile_kernel((y, float(t0), dt, 1, 0, decim, *model, ex, *work, np.empty(1),
-                                np.empty((1, ly.N_STATE)), np.empty((1, ly.N_SIG)),
-                                np.empty((1, ly.N_LOG)), st))
+    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, decim, *settings, *model, ex, *work,
+                                        np.empty(1), np.empty((1, ly.N_STATE)),
+                                        np.empty((1, ly.N_SIG)), np.empty((1, ly.N_LOG)), st,
+                                        *controller))
     t_wall = time.perf_counter()
     while done < n_steps:
         n = min(chunk, n_steps - done)
@@ -467,9 +502,9 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         out_t = np.empty(n_out)
         out_y = np.empty((n_out, ly.N_STATE))
         out_sig = np.empty((n_out, ly.N_SIG))
-        log = np.empty((_LOG_ROWS, ly.N_LOG))
-        status, stored, n_log = run_hybrid(y, t0 + done * dt, dt, n, done, decim, *model, ex, *work,
-                                           out_t, out_y, out_sig, log, st)
+        log = np.empty((log_rows, ly.N_LOG))
+        status, stored, n_log = kernel(y, t0 + done * dt, dt, n, done, decim, *settings, *model, ex,
+                                       *work, out_t, out_y, out_sig, log, st, *controller)
         parts_t.append(out_t[:stored])
         parts_y.append(out_y[:stored])
         parts_s.append(out_sig[:stored])
@@ -493,29 +528,97 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     run = _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
                     st, static_tip, label, t0)
     run.compile_s = compile_s
+    run.method = method
+    run.tol = tol
+    run.control = (control_summary(controller[1], controller[3], tol, dt) if controller
+                   else fixed_step_summary(dt, int(st[ly.ST_STEP])))
     return run
+
+
+def check_method(method: str | None, tol: float | None, dt_given: bool = False,
+                 names: dict | None = None) -> tuple[str, float | None]:
+    """The method and its tolerance (None for a fixed step); ParameterError on bad input.
+
+    Without a method, "rk4" when a step was given without a tolerance,
+    else DEFAULT_METHOD.  ``names`` maps "method" and "tol" to the names
+    the user wrote.
+    """
+    names = names or {}
+    if method is None:
+        method = "rk4" if dt_given and tol is None else DEFAULT_METHOD
+    if method not in METHODS:
+        raise ParameterError(f"{names.get('method', 'method')} = {method!r} is not a method; "
+                             f"use one of {', '.join(sorted(METHODS))}")
+    if not METHODS[method].controlled:
+        if tol is not None:
+            raise ParameterError(f"{names.get('tol', 'tol')} = {tol:g} is for the controlled "
+                                 f"method; {method!r} takes fixed steps (give dt instead)")
+        return method, None
+    tol = DEFAULT_TOL if tol is None else check_positive(names.get("tol", "tol"), tol, "")
+    if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
+        raise ParameterError(f"{names.get('tol', 'tol')} = {tol:g} is outside the allowed range "
+                             f"[{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}]")
+    return method, float(tol)
+
+
+def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: float) -> dict:
+    """The controlled run's steps, rejections and error estimate (Run.summary keys).
+
+    ``intervals_by_step`` counts the control intervals accepted at each
+    step (s) of the lattice of base step dt.
+    """
+    n_floor = int(ctl[ly.CTL_N_FLOOR])
+    floors = [{"t0": float(r[ly.FL_T0]), "t1": float(r[ly.FL_T1]),
+               "from_regime": int(r[ly.FL_FROM]), "to_regime": int(r[ly.FL_TO]),
+               "events": int(r[ly.FL_EVENTS]),
+               "error_over_tol": None if r[ly.FL_ERR] < 0 else float(r[ly.FL_ERR])}
+              for r in floor_log[:min(n_floor, len(floor_log))]]
+    done = ctl[ly.CTL_INTERVALS] > 0
+    names = [*Q_COLUMNS, *QD_COLUMNS, *ly.EV_NAMES]
+    arg = int(ctl[ly.CTL_ARG_ERR_MAX])
+    levels = {f"{dt / 2 ** j:.4g}": int(n) for j, n in enumerate(ctl[ly.CTL_LEVELS:]) if n > 0}
+    return {"steps": int(ctl[ly.CTL_STEPS]), "steps_all": int(ctl[ly.CTL_WORK]),
+            "intervals": int(ctl[ly.CTL_INTERVALS]), "rejected": int(ctl[ly.CTL_REJECTED]),
+            "h_min": float(ctl[ly.CTL_H_MIN]) if done else None,
+            "h_max": float(ctl[ly.CTL_H_MAX]) if done else None,
+            "error_est_max": float(ctl[ly.CTL_ERR_MAX] * tol),
+            "error_over_tol_max": float(ctl[ly.CTL_ERR_MAX]),
+            "t_error_max": float(ctl[ly.CTL_T_ERR_MAX]),
+            "error_max_in": names[arg] if done else None,
+            "rejected_by_events": int(ctl[ly.CTL_REJECTED_EVENTS]),
+            "intervals_by_step": levels,
+            "floor_count": n_floor, "floor_intervals": floors}
+
+
+def fixed_step_summary(dt: float, steps: int) -> dict:
+    """The summary keys of a fixed-step run: its steps, and no error estimate."""
+    return {"steps": steps, "steps_all": steps, "intervals": steps, "rejected": 0,
+            "h_min": dt, "h_max": dt, "error_est_max": None, "error_over_tol_max": None,
+            "t_error_max": None, "error_max_in": None, "rejected_by_events": 0,
+            "intervals_by_step": {f"{dt:.4g}": steps}, "floor_count": 0, "floor_intervals": []}
 
 
 #: What the first compile of the kernels takes (README "Two commands"), for the message.
 COMPILE_NOTE = "about 8 minutes on 2 cores"
 
 
-def compile_kernel(args) -> float:
-    """Compile the run kernel for these arguments' types, or load it from numba's cache.
+def compile_kernel(kernel, args) -> float:
+    """Compile a run kernel for these arguments' types, or load it from numba's cache.
 
     Returns the seconds spent (0 when already in this process).  When no
     cached machine code exists (the first run after an install or a change
     of ``workbench/core``), says so on stderr first, with the usual time.
     """
     import numba
-    if run_hybrid.signatures:
+    if kernel.signatures:
         return 0.0
     from ..core._cache import CACHE_DIR
-    if not any(CACHE_DIR.glob("hybrid.run_hybrid-*.nbi")):
+    module = kernel.py_func.__module__.rsplit(".", 1)[-1]
+    if not any(CACHE_DIR.glob(f"{module}.{kernel.__name__}-*.nbi")):
         print(f"workbench: compiling the numba kernels ({COMPILE_NOTE}; once, then cached in "
               f"{CACHE_DIR})", file=sys.stderr, flush=True)
     t = time.perf_counter()
-    run_hybrid.compile(tuple(numba.typeof(a) for a in args))
+    kernel.compile(tuple(numba.typeof(a) for a in args))
     return time.perf_counter() - t
 
 

@@ -141,7 +141,8 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
 def study_definition(study: Study) -> dict:
     return {"name": study.name, "description": study.description, "source": study.source,
             "duration_s": study.duration_s, "window_s": study.window_s, "sweep": study.sweep,
-            "dt": study.dt, "output_hz": study.output_hz, "initial": study.initial,
+            "dt": study.dt, "output_hz": study.output_hz, "method": study.method,
+            "tol": study.tol, "initial": study.initial,
             "excitation": study.excitation, "fixed": study.fixed, "axes": study.axes,
             "parameters_of_first_point": study.points[0].params.to_dict() if study.points else {}}
 
@@ -153,6 +154,29 @@ def summary(table: pd.DataFrame) -> dict:
             "not_steady": int((~ok.steady.astype(bool)).sum()) if len(ok) else 0,
             "cpu_s": float(table.wall_s.sum()) if len(table) else 0.0,
             "simulated_s": float(ok.simulated_s.sum()) if len(ok) else 0.0}
+
+
+def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
+    """The integration's accuracy: the method, the worst estimate, and every point above its tolerance."""
+    ok = table[table.status == "ok"] if len(table) else table
+    if study.tol is None or not len(ok) or "error_over_tol_max" not in ok:
+        return ([f"Integration: {study.method}, fixed step "
+                 f"{'the stability step' if study.dt is None else f'{study.dt:g} s'}: "
+                 "no error estimate.", ""])
+    worst = ok.loc[ok.error_over_tol_max.idxmax()]
+    lines = [f"Integration: {study.method}, tol = {study.tol:g}; the largest error estimate is "
+             f"{worst.error_over_tol_max:.3g} of the tolerance ({point_title(worst)}); steps "
+             f"{ok.h_min.min():.3g}-{ok.h_max.max():.3g} s.", ""]
+    over = ok[(ok.error_over_tol_max > 1.0) | (ok.floor_count > 0)]
+    if len(over):
+        lines += ["## Points above their tolerance", "",
+                  "Each has control intervals that met the tolerance only at the finest step, "
+                  "or not at all (`run.control['floor_intervals']` lists them).", "",
+                  "| point | estimate / tol | intervals at the floor |", "|---|---|---|"]
+        lines += [f"| {point_title(r)} | {r.error_over_tol_max:.3g} | {int(r.floor_count)} |"
+                  for _, r in over.iterrows()]
+        lines.append("")
+    return lines
 
 
 def render_index(study, table, figures, tables, out) -> str:
@@ -171,6 +195,7 @@ def render_index(study, table, figures, tables, out) -> str:
         lines += [f"| {point_title(r)} | {r.status} | {r.get('simulated_s', float('nan')):.3f} | "
                   f"{r.message} |" for _, r in failed.iterrows()]
         lines.append("")
+    lines += accuracy_lines(study, table)
     lines += ["## Tables", ""]
     for p in tables:
         lines.append(f"- [{p.name}]({p.relative_to(out)})")

@@ -5,7 +5,10 @@
     duration_s = 10.0                # simulated time per point (s)
     window_s = 2.0                   # steady-state window at the end of each point (s)
     sweep = "independent"            # or "up", "down", "up-down" (stepped frequency sweeps)
-    dt = 5e-5                        # optional RK4 step (s); default: simulate.default_dt
+    tol = 1e-4                       # optional tolerance of the controlled method (the default)
+    method = "controlled"            # optional: "controlled", or "rk4" (fixed steps of dt)
+    dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
+                                     # controlled method's coarsest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
                                      # (each selector names axis values; {} selects every point)
@@ -47,7 +50,8 @@ from ..model.limits import FREE_DECAY_MAX_CM, MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 SWEEP_MODES = ("independent", "up", "down", "up-down")
-STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz",
+STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz", "tol",
+              "method",
               "save_series", "initial"}
 
 
@@ -98,6 +102,8 @@ class Study:
     axes: dict
     save_series: tuple = ()
     source: str = ""
+    method: str = "controlled"
+    tol: float | None = None
     points: tuple = field(default=(), repr=False)
 
     @property
@@ -169,6 +175,12 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     if dt is not None:
         dt = check_positive("[study] dt", dt, "s")
     output_hz = check_positive("[study] output_hz", head.get("output_hz", 1000.0), "Hz")
+    from ..model.simulate import check_method
+    tol = head.get("tol")
+    if tol is not None and (isinstance(tol, bool) or not isinstance(tol, (int, float))):
+        raise StudyError(f"[study] tol = {_short(tol)} must be a number")
+    method, tol = check_method(head.get("method"), tol, dt_given=dt is not None,
+                               names={"method": "[study] method", "tol": "[study] tol"})
     if abs(duration * output_hz - round(duration * output_hz)) > 1e-9 * duration * output_hz:
         raise StudyError(f"[study] duration_s = {duration} s must be a whole number of samples "
                          f"at output_hz = {output_hz} Hz (the last sample is the final state)")
@@ -259,7 +271,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     return Study(name=name, description=str(head.get("description", "")), duration_s=duration,
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
                  excitation={"kind": kind, **exc}, fixed=fixed, axes=axes, save_series=series,
-                 source=source, points=tuple(points))
+                 source=source, points=tuple(points), method=method, tol=tol)
 
 
 def _short(value) -> str:

@@ -46,6 +46,9 @@ SECONDS_PER_STEP = 2e-5
 WATCHDOG_S = 1.0
 
 STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
+#: The integrator's account kept in a point's row (Run.summary keys).
+CONTROL_KEYS = ("steps", "steps_all", "rejected", "h_min", "h_max", "error_est_max",
+                "error_over_tol_max", "floor_count")
 
 
 def point_key(study: Study, point: Point, previous_key: str = "") -> str:
@@ -54,7 +57,7 @@ def point_key(study: Study, point: Point, previous_key: str = "") -> str:
         "params": point.params.to_dict(), "excitation": point.excitation,
         "first_in_chain": point.step == 0, "duration_s": study.duration_s,
         "window_s": study.window_s, "dt": study.dt, "output_hz": study.output_hz,
-        "initial": study.initial, "previous": previous_key, "code": code_version(),
+        "method": study.method, "tol": study.tol, "initial": study.initial, "previous": previous_key, "code": code_version(),
     }
     text = json.dumps(record, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -82,6 +85,9 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
         row["max_correction_cm"] = float(run.stats["max_correction_cm"])
         row["t_max_penetration"] = float(run.stats["t_max_penetration"])
         row["energy_balance_rel"] = run.energy_balance_rel()
+        row["method"] = run.method
+        row["tol"] = run.tol
+        row.update({key: run.control[key] for key in CONTROL_KEYS})
         row.update(contact_checks(run))
         row["static_tip_y"] = run.static_tip_y
         final = run.signals.iloc[-1]
@@ -97,7 +103,7 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> 
     try:
         run = simulate(point.params, point.excitation_array(first_in_chain=not continued),
                        study.duration_s, dt=study.dt, output_hz=study.output_hz,
-                       initial=initial if continued else study.initial,
+                       method=study.method, tol=study.tol, initial=initial if continued else study.initial,
                        **point.start_keywords)
         metrics = point_metrics(run, study.window_s, point.drive_hz) if run.ok else {}
         row = _row(point, key, "ok" if run.ok else "failed", run.message,

@@ -1,0 +1,66 @@
+"""The registry of integration methods: what ``simulate(method=...)`` and ``--method`` take.
+
+A method is a kernel with the calling convention of
+:func:`workbench.core.hybrid.run_hybrid` (fixed steps) or of
+:func:`workbench.core.controlled.run_controlled` (steps chosen by an error
+estimate, which adds its controller's arrays); both step with
+:func:`workbench.core.hybrid.advance`, the event logic.  A new method is
+one kernel module in ``workbench/core`` and one :func:`register` call here.
+
+``controlled`` (the default): RK4 steps on a lattice of dt / 2^k inside
+each control interval, chosen by step doubling against ``tol``
+(:mod:`workbench.core.controlled` states what is controlled and how it is
+scaled).  ``rk4``: fixed RK4 steps of dt, as given (``--dt``) or the
+stability step, with no error estimate: earlier results are reproduced
+with it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from ..core.controlled import run_controlled
+from ..core.hybrid import run_hybrid
+
+#: The default relative tolerance of the controlled method: the local error
+#: of each control interval, over the scale of each controlled quantity.
+DEFAULT_TOL = 1e-4
+#: The tolerance's allowed range.
+TOL_RANGE = (1e-9, 1e-1)
+#: The finest level by default: steps down to dt / 2^DEFAULT_LEVEL_MAX.
+DEFAULT_LEVEL_MAX = 6
+#: A control interval is at most this many base steps (a divisor of the output interval).
+MAX_SEGMENT_STEPS = 16
+#: Rows of the record of intervals accepted at the finest level.
+FLOOR_LOG_ROWS = 2000
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    kernel: Callable
+    controlled: bool
+    description: str
+
+
+METHODS: dict[str, Method] = {}
+
+
+def register(method: Method) -> Method:
+    METHODS[method.name] = method
+    return method
+
+
+register(Method("controlled", run_controlled, True,
+                "RK4 on the output lattice, steps dt/2^k chosen by step doubling against tol"))
+register(Method("rk4", run_hybrid, False, "fixed-step RK4 (dt as given, or the stability step)"))
+
+DEFAULT_METHOD = "controlled"
+
+
+def segment_steps(decim: int, n_steps: int) -> int:
+    """Base steps per control interval: the largest divisor of decim and n_steps up to MAX_SEGMENT_STEPS."""
+    for seg in range(min(MAX_SEGMENT_STEPS, decim), 0, -1):
+        if decim % seg == 0 and n_steps % seg == 0:
+            return seg
+    return 1
