@@ -20,9 +20,10 @@ doubling).  The fine path is accepted when
   stick margin the largest total normal force so far (not below the loose
   body's weight); for a slip rate the loose body's velocity scale.
 
-The estimate (the largest of these ratios, over ``tol``) is the difference
-of the two paths: for RK4 about 15 times the fine path's own error where
-the motion is smooth.  A rejected interval is redone one level finer, the
+The estimate is Richardson's error of the fine path: the difference of the
+two paths over 2^ORDER - 1 (15 for RK4), which is the fine path's own
+error where the motion is smooth; the largest of these ratios over ``tol``
+decides.  A rejected interval is redone one level finer, the
 fine path becoming the coarse one; an accepted estimate below COARSEN
 lets the next interval try one level coarser.  At ``level_max`` (steps of
 dt / 2^(level_max + 1)) the fine path is accepted whatever the estimate and
@@ -35,10 +36,13 @@ from .config import JIT, JIT_INLINE, MAX_EVENTS_PER_STEP
 from . import layout as ly
 from .contact import regime_of
 from .hybrid import _store, advance, begin
+from .integrate import ORDER
 
+#: Richardson's factor: the difference of the two paths over the fine path's error.
+RICHARDSON = 2.0 ** ORDER - 1.0
 #: An accepted interval whose estimate is below this lets the next one try a
-#: level coarser (RK4 halves its error 16-fold per level; with a margin of 2).
-COARSEN = 1.0 / 32.0
+#: level coarser (a level divides the error by 2^ORDER; with a margin of 2).
+COARSEN = 0.5 / 2.0 ** ORDER
 #: Floors of the error scales: the clearance (cm) for positions (over a
 #: length for angles), and that times REF_RATE (1/s) for velocities.
 REF_RATE = 100.0
@@ -129,7 +133,7 @@ def _grow_scales(y, rg, scale, ctl):
 
 @nb.njit(**JIT)
 def interval_error(tol, a, n_coarse, b, n_fine, P, stages, ev, log, snap, scale, ctl):
-    """The error estimate of an interval over ``tol``: fine path at STAGE_CUR, coarse in snap.
+    """The fine path's error estimate over ``tol``: fine path at STAGE_CUR, coarse in snap.
 
     The coarse path's events are log rows [a, a + n_coarse), the fine
     path's [b, b + n_fine).  Returns ``(estimate, component)``: the
@@ -169,7 +173,7 @@ def interval_error(tol, a, n_coarse, b, n_fine, P, stages, ev, log, snap, scale,
         if r > err:
             err = r
             arg = ly.N_STATE + e
-    return err, arg
+    return err / RICHARDSON, arg
 
 
 @nb.njit(**JIT_INLINE)

@@ -22,6 +22,8 @@ from .constrained import rhs_regime
 _C = (0.0, 0.5, 0.5, 1.0)
 _A_NEXT = (0.5, 0.5, 1.0)
 _B = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
+#: The order of the step (global error O(dt^ORDER)).
+ORDER = 4
 
 
 @nb.njit(**JIT)

@@ -24,7 +24,7 @@ from ..core.hybrid import run_hybrid
 
 #: The default relative tolerance of the controlled method: the local error
 #: of each control interval, over the scale of each controlled quantity.
-DEFAULT_TOL = 1e-4
+DEFAULT_TOL = 2e-4
 #: The tolerance's allowed range.
 TOL_RANGE = (1e-9, 1e-1)
 #: The finest level by default: steps down to dt / 2^DEFAULT_LEVEL_MAX.
