@@ -32,7 +32,7 @@ DURATION_S = 1.0
 RAMP_S = 0.5
 WINDOW = (0.5, 1.0)
 CONVERGED_DIVISOR = 64
-RK4_DIVISORS = (1, 2, 4)
+RK4_DIVISORS = (1, 2, 4, 8)
 
 
 def issue_cases() -> dict:

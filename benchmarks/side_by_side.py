@@ -74,6 +74,12 @@ def full_run(case: Case, dt: float | None = None):
     return simulate(case.params, case.excitation, case.duration_s, dt=dt, output_hz=SAMPLE_HZ)
 
 
+def fixed_run(case: Case):
+    """The whole run at fixed RK4 steps of the default step (the method before the controlled one)."""
+    return simulate(case.params, case.excitation, case.duration_s, method="rk4",
+                    output_hz=SAMPLE_HZ)
+
+
 #: A window must hold at least this many of the kernel's events.
 MIN_WINDOW_EVENTS = 4
 
@@ -125,16 +131,25 @@ def _samples(case: Case, t0: float) -> np.ndarray:
     return t0 + np.arange(round(case.window_s * SAMPLE_HZ) + 1) / SAMPLE_HZ
 
 
-def kernel_window(case: Case, t0: float, y0: np.ndarray, regime: int, dt: float) -> Window:
-    """The kernel over the window from (t0, y0) in ``regime`` at step dt."""
+def kernel_window(case: Case, t0: float, y0: np.ndarray, regime: int, dt: float | None,
+                  tol: float | None = None) -> Window:
+    """The kernel over the window from (t0, y0) in ``regime``: fixed RK4 steps of dt, or the
+    controlled method at ``tol``."""
     start = time.perf_counter()
-    run = simulate(case.params, case.excitation, case.window_s, dt=dt, output_hz=SAMPLE_HZ,
-                   initial=y0, t0=t0, regime=regime)
+    run = simulate(case.params, case.excitation, case.window_s, dt=dt, tol=tol,
+                   output_hz=SAMPLE_HZ, initial=y0, t0=t0, regime=regime)
     wall = time.perf_counter() - start
+    setting = dt if tol is None else tol
     if not run.ok:
-        raise RuntimeError(f"kernel window at dt = {dt}: {run.message}")
-    return Window("workbench RK4", dt, wall, run.signals.index.to_numpy(),
+        raise RuntimeError(f"kernel window at {run.method} {setting}: {run.message}")
+    solver = "workbench RK4" if tol is None else "workbench controlled"
+    return Window(solver, setting, wall, run.signals.index.to_numpy(),
                   run.signals.tip_y.to_numpy(), run.contact_time_share(), len(run.events) - 1)
+
+
+def controlled_window(case: Case, t0: float, y0: np.ndarray, regime: int, tol: float) -> Window:
+    """The kernel's controlled method over the window at ``tol``."""
+    return kernel_window(case, t0, y0, regime, None, tol)
 
 
 def lsoda_window(case: Case, t0: float, y0: np.ndarray, regime: int, rtol: float) -> Window:

@@ -73,22 +73,25 @@ def _run_id(bench) -> str:
 
 
 def whole_table(b) -> list[str]:
-    rows = ["| run (defaults: 1.016 mm, 200 N, cubic cork) | step (s) | wall (s), median | rounds "
-            "| simulated s per wall s | events |", "|---|---|---|---|---|---|"]
+    rows = ["| run (defaults: 1.016 mm, 200 N, cubic cork) | method | base step (s) | wall (s), "
+            "median | rounds | simulated s per wall s | events |",
+            "|---|---|---|---|---|---|---|"]
     for key in WHOLE_CASES:
-        bench = b.get(f"test_whole_run[{key}]")
-        if bench:
-            info, wall = bench["extra_info"], _median(bench)
-            rows.append(f"| {info['case']} | {info['dt']:g} | {wall:.2f} | "
-                        f"{bench['stats']['rounds']} | {info['simulated_s'] / wall:.1f} | "
-                        f"{info['n_events']} |")
+        for name, method in ((f"test_whole_run[{key}]", "controlled (default)"),
+                             (f"test_whole_run_fixed_step[{key}]", "fixed RK4")):
+            bench = b.get(name)
+            if bench:
+                info, wall = bench["extra_info"], _median(bench)
+                rows.append(f"| {info['case']} | {method} | {info['dt']:g} | {wall:.2f} | "
+                            f"{bench['stats']['rounds']} | {info['simulated_s'] / wall:.1f} | "
+                            f"{info['n_events']} |")
     return rows
 
 
 def _window_rows(b, key) -> list[dict]:
     """The accuracy entries of one case: kernel rows (largest step first), then LSODA's."""
     out = []
-    for prefix in ("test_accuracy_kernel", "test_accuracy_lsoda"):
+    for prefix in ("test_accuracy_kernel", "test_accuracy_controlled", "test_accuracy_lsoda"):
         entries = [v for k, v in b.items() if k.startswith(f"{prefix}[{key}-")]
         entries.sort(key=lambda v: -v["extra_info"]["setting"])
         for bench in entries:
@@ -99,7 +102,7 @@ def _window_rows(b, key) -> list[dict]:
 
 
 def lsoda_ratio(b, key) -> tuple[float, str] | None:
-    """LSODA's wall over the kernel's (default step) on the case's window, at equal accuracy.
+    """LSODA's wall over the kernel's (default settings) on a window, at equal accuracy.
 
     The cheapest LSODA tolerance whose tip and share errors are both at most
     the kernel's; if none is, the cheapest tolerance tried (each is then
@@ -107,8 +110,10 @@ def lsoda_ratio(b, key) -> tuple[float, str] | None:
     (ratio, how it was chosen).
     """
     rows = _window_rows(b, key)
-    kernel = next((r for r in rows if r["solver"] == "workbench RK4" and r.get("default")), None)
-    lsoda = [r for r in rows if r["solver"] != "workbench RK4"]
+    own = [r for r in rows if r["solver"].startswith("workbench") and r.get("default")]
+    kernel = next((r for r in own if r["solver"] == "workbench controlled"), None) or next(
+        iter(own), None)
+    lsoda = [r for r in rows if not r["solver"].startswith("workbench")]
     if kernel is None or not lsoda:
         return None
     as_good = [r for r in lsoda if r["tip_error_rel"] <= kernel["tip_error_rel"]
@@ -144,7 +149,7 @@ def accuracy_table(b) -> list[str]:
                          f"{info['converged_share_error']:.1e} (shares).")
         ratio = lsoda_ratio(b, key)
         if ratio:
-            notes.append(f"  LSODA's wall over the kernel's at its default step: "
+            notes.append(f"  LSODA's wall over the kernel's at its default settings: "
                          f"**{ratio[0]:.0f}×** ({ratio[1]}).")
     return rows + ([""] + notes if notes else [])
 
@@ -231,9 +236,10 @@ def summary(b: dict, data: dict) -> str:
 
 
 _TABLE_PREFIXES = {"Cost": ("test_rhs",),
-                   "Whole": tuple(f"test_whole_run[{key}]" for key in WHOLE_CASES),
+                   "Whole": tuple(f"test_whole_run{kind}[{key}]" for key in WHOLE_CASES
+                                  for kind in ("", "_fixed_step")),
                    "Accuracy": tuple(f"test_accuracy_{solver}[{key}-" for key in WINDOW_CASES
-                                     for solver in ("kernel", "lsoda")),
+                                     for solver in ("kernel", "controlled", "lsoda")),
                    "A": ("test_workbench_run",),
                    "Sweeps": ("test_sweep_scaling", "test_make_study")}
 

@@ -370,12 +370,12 @@ def test_default_step_is_the_largest_stable_nice_step(tip, expected):
 def test_a_run_continued_from_its_state_follows_the_whole_run():
     p = Parameters().replace(gap_mm=1.016)
     ex = X.sine(X.DEFAULT_FORCE_N, 20.0, ramp_s=0.2)
-    whole = simulate(p, ex, 0.6)
+    whole = simulate(p, ex, 0.6, method="rk4")     # the same lattice of steps in both
     sig = whole.signals
     k = int(np.argmin(np.abs(sig.index.to_numpy() - 0.3)))
     cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]
     rest = simulate(p, ex, 0.3, initial=sig[cols].iloc[k].to_numpy(), t0=float(sig.index[k]),
-                    regime=int(sig.regime.iloc[k]))
+                    regime=int(sig.regime.iloc[k]), method="rk4")
     assert rest.ok and rest.simulated_s == pytest.approx(0.3)
     assert rest.signals.index[0] == pytest.approx(0.3) and rest.t_end == pytest.approx(0.6)
     later = whole.events[whole.events.t > 0.3 + 1e-9]

@@ -66,6 +66,10 @@ def test_small_grid_end_to_end(small_run):
     assert (table.tip_rms > 0).all() and table.steady.dtype == bool
     on_disk = pd.read_parquet(root / "res1" / "small" / "points.parquet")
     pd.testing.assert_frame_equal(on_disk, table)
+    # each point keeps the integrator's account: the default method met its tolerance
+    assert (table.method == "controlled").all() and (table.tol == study.tol).all()
+    assert (table.error_over_tol_max <= 1.0).all() and (table.floor_count == 0).all()
+    assert (table.steps_all >= table.steps).all() and (table.h_min <= table.h_max).all()
     series = sorted(p.name for p in (root / "res1" / "small" / "series").iterdir())
     assert len(series) == 2          # one named point: signals + events
     key = table[(table.axis_gap_mm == 1.016) & (table.axis_freq_hz == 20.0)].key.iloc[0]
@@ -133,15 +137,17 @@ def test_a_failing_point_is_recorded_and_the_sweep_goes_on(small_run, tmp_path, 
 
 
 def test_an_unstable_point_is_recorded_as_failed(tmp_path, monkeypatch):
-    """A run that ends with a failure status (here: a step far beyond RK4's stability, which
-    a study cannot ask for, forced through the API) is a recorded point, with its figures."""
+    """A run that ends with a failure status (here: fixed RK4 steps far beyond its stability,
+    which a study cannot ask for, forced through the API) is a recorded point, with its
+    figures.  (The controlled method refines such a step until it is stable.)"""
     text = SMALL.replace("gap_mm = [0.508, 1.016]", "gap_mm = [1.016]").replace(
         "freq_hz = [20.0, 30.0]", "freq_hz = [20.0]")
     with pytest.raises(ParameterError, match="stability limit"):
         S.load(write(tmp_path, text.replace("window_s = 0.2", "window_s = 0.2\ndt = 1e-3"),
                      "unstable.toml"))
     real = W.simulate
-    monkeypatch.setattr(W, "simulate", lambda p, ex, *a, **kw: real(p, ex, *a, **{**kw, "dt": 1e-3}))
+    monkeypatch.setattr(W, "simulate", lambda p, ex, *a, **kw: real(
+        p, ex, *a, **{**kw, "dt": 1e-3, "method": "rk4", "tol": None}))
     table = W.run_study(S.load(write(tmp_path, text)), tmp_path / "res", jobs=1, progress=False)
     assert table.status.tolist() == ["failed"]
     assert table.message.iloc[0]
@@ -246,6 +252,23 @@ def test_report_figures_and_tables_of_a_grid(small_run):
     assert prov["runs"][0]["wall_s"] > 0 and prov["points"]["total"] == 4
     # the bifurcation samples: one per forcing period of the window
     assert all(len(s) == round(0.2 * f) + 1 for s, f in zip(table.tip_poincare, table.axis_freq_hz))
+
+
+def test_the_report_names_the_largest_estimate_and_flags_points_above_the_tolerance(small_run):
+    from workbench.present.report import accuracy_lines
+
+    study, _, table = small_run
+    text = "\n".join(accuracy_lines(study, table))
+    worst = table.error_over_tol_max.max()
+    assert f"tol = {study.tol:g}" in text and f"{worst:.3g} of the tolerance" in text
+    assert "above their tolerance" not in text
+    over = table.copy()
+    over.loc[over.index[1], "error_over_tol_max"] = 3.5
+    over.loc[over.index[2], "floor_count"] = 2
+    text = "\n".join(accuracy_lines(study, over))
+    assert "## Points above their tolerance" in text
+    rows = [line for line in text.splitlines() if line.startswith("| ") and "estimate" not in line]
+    assert len(rows) == 2 and "| 3.5 | 0 |" in rows[0] and rows[1].endswith("| 2 |")
 
 
 def test_report_drawn_by_two_processes_is_the_serial_one(small_run, tmp_path):

@@ -574,7 +574,7 @@ def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: floa
                "error_over_tol": None if r[ly.FL_ERR] < 0 else float(r[ly.FL_ERR])}
               for r in floor_log[:min(n_floor, len(floor_log))]]
     done = ctl[ly.CTL_INTERVALS] > 0
-    names = [*Q_COLUMNS, *QD_COLUMNS, *ly.EV_NAMES]
+    names = [*Q_COLUMNS, *QD_COLUMNS, *ly.EV_NAMES, "event_time"]
     arg = int(ctl[ly.CTL_ARG_ERR_MAX])
     levels = {f"{dt / 2 ** j:.4g}": int(n) for j, n in enumerate(ctl[ly.CTL_LEVELS:]) if n > 0}
     return {"steps": int(ctl[ly.CTL_STEPS]), "steps_all": int(ctl[ly.CTL_WORK]),
