@@ -18,7 +18,8 @@ doubling).  The fine path is accepted when
   body's slide and offset), not below a floor from the model's clearance
   (:func:`_floors`); for a gap the clearance; for a normal force or the
   stick margin the largest total normal force so far (not below the loose
-  body's weight); for a slip rate the loose body's velocity scale.
+  body's weight); for a slip rate the loose body's velocity scale; and
+  the time of every event, on the scale of the interval's length.
 
 The estimate is Richardson's error of the fine path: the difference of the
 two paths over 2^ORDER - 1 (15 for RK4), which is the fine path's own
@@ -132,24 +133,30 @@ def _grow_scales(y, rg, scale, ctl):
 
 
 @nb.njit(**JIT)
-def interval_error(tol, a, n_coarse, b, n_fine, P, stages, ev, log, snap, scale, ctl):
+def interval_error(tol, span, a, n_coarse, b, n_fine, P, stages, ev, log, snap, scale, ctl):
     """The fine path's error estimate over ``tol``: fine path at STAGE_CUR, coarse in snap.
 
     The coarse path's events are log rows [a, a + n_coarse), the fine
-    path's [b, b + n_fine).  Returns ``(estimate, component)``: the
-    component of (q, q') (0..17) or the event function (N_STATE + e) with
-    the largest ratio; (MISMATCH, -1) when the event sequences differ.
+    path's [b, b + n_fine); ``span`` (s) is the interval's length, the scale
+    of the events' times.  Returns ``(estimate, component)``: the component
+    of (q, q') (0..17), the event function (N_STATE + e) or the event times
+    (N_STATE + N_EV) with the largest ratio; (MISMATCH, -1) when the event
+    sequences differ.
     """
     if n_coarse != n_fine:
         return MISMATCH, -1
+    err = 0.0
+    arg = 0
     for i in range(n_fine):
         for col in (ly.LOG_KIND, ly.LOG_POINT, ly.LOG_TO):
             if log[a + i, col] != log[b + i, col]:
                 return MISMATCH, -1
+        r = abs(log[a + i, ly.LOG_T] - log[b + i, ly.LOG_T]) / (tol * span)
+        if r > err:
+            err = r
+            arg = ly.N_STATE + ly.N_EV
     y = stages[ly.STAGE_CUR]
     c = ly.SNAP_COARSE
-    err = 0.0
-    arg = 0
     for i in range(ly.N_STATE):
         j = PARTNER[i % ly.N_DOF] + (i // ly.N_DOF) * ly.N_DOF
         s = tol * max(scale[ly.SCALE_FLOOR, i], scale[ly.SCALE_PEAK, i], scale[ly.SCALE_PEAK, j],
@@ -245,8 +252,8 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
                 return ly.LOG_FULL, stored, n_log
             err, arg = MISMATCH, -1
             if status == ly.OK and coarse_ok:
-                err, arg = interval_error(tol, n_log, end_c - n_log, end_c, end_f - end_c, P, stages,
-                                     ev, log, snap, scale, ctl)
+                err, arg = interval_error(tol, seg * dt, n_log, end_c - n_log, end_c,
+                                          end_f - end_c, P, stages, ev, log, snap, scale, ctl)
             _move_rows(log, end_c, end_f - end_c, n_log)
             end_f = n_log + end_f - end_c
             if err <= 1.0 or k + 1 >= level_max:
