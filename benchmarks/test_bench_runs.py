@@ -20,7 +20,7 @@ import pytest
 
 from side_by_side import (CASES, CONVERGED_DT, controlled_window, fixed_run, full_run,
                           kernel_window, lsoda_window, window_start)
-from workbench.model.methods import DEFAULT_TOL
+from workbench.model.limits import DEFAULT_TOL
 from workbench.model.simulate import default_dt, simulate
 
 #: The kernel's steps on the windows, as fractions of the case's default step.

@@ -35,8 +35,8 @@ from pathlib import Path
 from . import __version__
 from .model.params import CORK_MODELS, ParameterError, Parameters, describe
 from .study.paths import check_output_dir, check_output_file
-from .model.limits import (FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MAX_OUTPUT_HZ,
-                           MIN_DT)
+from .model.limits import (DEFAULT_TOL, FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N,
+                           MAX_OUTPUT_HZ, MIN_DT)
 
 EXIT_OK = 0
 EXIT_RUN_FAILED = 1
@@ -653,7 +653,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="integration method: controlled (default: steps chosen by the error "
                      "against --tol) or rk4 (fixed steps of --dt)")
     run.add_argument("--tol", type=_number(0, lo_open=True), default=None,
-                     help="relative tolerance of the controlled method (default 1e-4; "
+                     help=f"relative tolerance of the controlled method (default {DEFAULT_TOL:g}; "
                      "docs/model.md 'Integration')")
     run.add_argument("--output-hz", type=_number(0, MAX_OUTPUT_HZ, lo_open=True), default=1000.0, help="sample rate of the signals")
     run.add_argument("--initial", choices=("static", "paper"), default="static",

@@ -6,7 +6,7 @@ import pytest
 
 from workbench.core import layout as ly
 from workbench.model import excitation as X
-from workbench.model.methods import DEFAULT_TOL
+from workbench.model.limits import DEFAULT_TOL
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.simulate import default_dt, simulate
 

@@ -48,6 +48,20 @@ def test_event_times_agree_with_the_reference(both):
         assert k.ke_lost == pytest.approx(r["ke_lost"], rel=1e-5, abs=1e-9)
 
 
+def test_the_default_tolerance_takes_the_references_events(both):
+    """The controlled method at its default tolerance, not told the step: every event of the
+    reference, in order, within 1e-6 s."""
+    ref_log = both[1]
+    run = simulate(Parameters(), None, HORIZON, initial="paper")
+    assert run.ok and run.method == "controlled" and run.control["floor_count"] == 0
+    ev = run.events[run.events.kind != "start"]
+    assert len(ev) == len(ref_log)
+    for k, r in zip(ev.itertuples(), ref_log):
+        assert (k.kind, k.from_regime, k.to_regime, k.point) == \
+               (r["kind"], r["from_regime"], r["to_regime"], r["point"])
+        assert abs(k.t - r["t"]) < 1e-6, (k, r)
+
+
 def test_end_state_agrees_with_the_reference(both):
     kernel, _, ref_end = both[:3]
     cols = list(ly.COORD_NAMES) + [c + "_dot" for c in ly.COORD_NAMES]

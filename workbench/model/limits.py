@@ -11,6 +11,11 @@ MIN_DT = 1e-7
 #: The largest step (s): RK4 is unstable far below it for this model; the
 #: model's own limit is :func:`workbench.model.simulate.stability_limit`.
 MAX_DT = 1e-3
+#: The controlled method's relative tolerance: its default and allowed range
+#: (docs/model.md "Integration"; the default is the largest measured to keep
+#: the event times of the 36 ms reference case within 1e-6 s, docs/performance.md).
+DEFAULT_TOL = 2e-5
+TOL_RANGE = (1e-9, 1e-1)
 #: The largest sample rate of the stored signals (Hz).
 MAX_OUTPUT_HZ = 1e6
 #: The largest shaker amplitude or hammer peak (N): 50 times the 200 N of

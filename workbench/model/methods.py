@@ -8,9 +8,9 @@ estimate, which adds its controller's arrays); both step with
 one kernel module in ``workbench/core`` and one :func:`register` call here.
 
 ``controlled`` (the default): RK4 steps on a lattice of dt / 2^k inside
-each control interval, chosen by step doubling against ``tol``
-(:mod:`workbench.core.controlled` states what is controlled and how it is
-scaled).  ``rk4``: fixed RK4 steps of dt, as given (``--dt``) or the
+each control interval, chosen by step doubling against ``tol`` (default
+:data:`workbench.model.limits.DEFAULT_TOL`; :mod:`workbench.core.controlled`
+states what is controlled and how it is scaled).  ``rk4``: fixed RK4 steps of dt, as given (``--dt``) or the
 stability step, with no error estimate: earlier results are reproduced
 with it.
 """
@@ -22,11 +22,6 @@ from typing import Callable
 from ..core.controlled import run_controlled
 from ..core.hybrid import run_hybrid
 
-#: The default relative tolerance of the controlled method: the local error
-#: of each control interval, over the scale of each controlled quantity.
-DEFAULT_TOL = 2e-4
-#: The tolerance's allowed range.
-TOL_RANGE = (1e-9, 1e-1)
 #: The finest level by default: steps down to dt / 2^DEFAULT_LEVEL_MAX.
 DEFAULT_LEVEL_MAX = 6
 #: A control interval is at most this many base steps (a divisor of the output interval).

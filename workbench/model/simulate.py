@@ -24,9 +24,9 @@ import numpy as np
 from . import packing as mdl
 from ..core import layout as ly
 from .excitation import none
-from .methods import (DEFAULT_LEVEL_MAX, DEFAULT_METHOD, DEFAULT_TOL, FLOOR_LOG_ROWS, METHODS,
-                      TOL_RANGE, segment_steps)
-from .limits import MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD
+from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
+from .limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD,
+                     TOL_RANGE)
 from ..study.metrics import contact_shares_of
 from .params import ParameterError, Parameters, check_positive
 from .regimes import contact_code, in_contact, is_stick, set_of
