@@ -35,13 +35,11 @@ import pandas as pd
 from ..core import layout as ly
 from .metrics import contact_checks, point_metrics
 from .provenance import code_version
+from ..model.methods import METHODS
 from ..model.simulate import default_dt, simulate
 from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
 from .definition import Point, Study
 
-#: Wall seconds per RK4 step assumed by :func:`plan` when the study has no
-#: run log yet (a contact-rich 10 s point at 1e-4 s takes ~1-2 s).
-SECONDS_PER_STEP = 2e-5
 #: A worker whose sweep process is gone stops within this many seconds.
 WATCHDOG_S = 1.0
 
@@ -186,7 +184,7 @@ def plan(study: Study, results: str | Path = "results", fresh: bool = False,
     """What a sweep would do: points, how many are finished, the expected steps and wall time.
 
     The wall time uses the study's own past seconds per step (runs.json) if
-    it has run before, else SECONDS_PER_STEP; divided by the workers.
+    it has run before, else its method's ``seconds_per_step``; divided by the workers.
     """
     out = Path(results) / study.name
     if fresh:
@@ -195,7 +193,7 @@ def plan(study: Study, results: str | Path = "results", fresh: bool = False,
     else:
         keys, todo = _unfinished(study, out)
     steps = sum(estimated_cost(study, c) for c, _ in todo)
-    per_step, basis = SECONDS_PER_STEP, "assumed"
+    per_step, basis = METHODS[study.method].seconds_per_step, "assumed"
     past = [r for r in read_runs(out) if r.get("state") == "done" and r.get("steps")]
     if past:
         per_step = sum(r["wall_s"] * r.get("jobs", 1) for r in past) / sum(r["steps"] for r in past)
