@@ -254,9 +254,6 @@ class Run:
     method: str = "rk4"
     tol: float | None = None    # the controlled method's relative tolerance
     control: dict = field(default_factory=dict)   # steps, rejections, error estimate (summary())
-    method: str = "rk4"
-    tol: float | None = None    # the controlled method's relative tolerance
-    control: dict = field(default_factory=dict)   # steps, rejections, error estimate (summary())
 
     @property
     def ok(self) -> bool:
