@@ -36,3 +36,14 @@ def rng():
 @pytest.fixture(params=[True, False], ids=["tip", "notip"])
 def params(request):
     return Parameters(tip_mass=request.param)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Fail the run if a kernel was compiled in more than one version
+    (a literal or omitted argument, or a test passing other types;
+    tests/core/test_compile.py)."""
+    from workbench.core._cache import kernel_versions
+    extra = {k: n for k, n in kernel_versions().items() if n > 1}
+    if extra:
+        print(f"\nkernels compiled in more than one version: {extra}", file=sys.stderr)
+        session.exitstatus = 1

@@ -1,4 +1,7 @@
 """The numba cache is keyed by the kernel sources (workbench/core/_cache.py)."""
+import os
+import time
+
 from workbench.core import _cache
 from workbench.core.constrained import rhs_regime
 from workbench.core.hybrid import run_hybrid
@@ -23,3 +26,18 @@ def test_the_hash_changes_with_any_kernel_source(tmp_path, monkeypatch):
     assert before == _cache.source_hash()
     (tmp_path / "integrate.py").write_text((tmp_path / "integrate.py").read_text() + "\n# x\n")
     assert _cache.source_hash() != before
+
+
+def test_a_shared_root_keeps_the_live_caches_of_other_versions(tmp_path, monkeypatch):
+    mine, other, stale = (tmp_path / f"numba-{n}" for n in ("mine", "other", "stale"))
+    for folder in (mine, other, stale):
+        folder.mkdir()
+    old = time.time() - (_cache.PRUNE_AFTER_DAYS + 1) * 86400.0
+    os.utime(mine, (old, old))
+    os.utime(stale, (old, old))
+    monkeypatch.setattr(_cache, "CACHE_ROOT", tmp_path)
+    monkeypatch.setattr(_cache, "CACHE_DIR", mine)
+    _cache.install()
+    assert mine.is_dir() and mine.stat().st_mtime > old + 86400.0     # marked as used
+    assert other.is_dir()                                              # another checkout's
+    assert not stale.exists()                                          # unused for 15 days

@@ -11,15 +11,21 @@ the old friction and a slip phase drifted 6e-4 cm/s off the new equations.)
 This module keys the cache by a hash of all kernel sources (config.py
 included): the kernels of ``workbench.core`` are cached under
 ``__pycache__/numba-<hash>/``, so any change to any of them compiles
-everything afresh, and entries of other versions are removed.  The
-environment variable ``WORKBENCH_CACHE_ROOT`` puts the ``numba-<hash>``
-folders elsewhere (a read-only install; the compile benchmark's cold start).
+everything afresh.  The environment variable ``WORKBENCH_CACHE_ROOT`` puts
+the ``numba-<hash>`` folders elsewhere: a read-only install, the compile
+benchmark's cold start, or one folder shared by several checkouts and
+machines of the same kind (numba's index is keyed by the source's content,
+the CPU and numba's version, not by a path or a timestamp).  Every import
+marks its own version's folder as used; folders of other versions unused
+for :data:`PRUNE_AFTER_DAYS` are removed, so checkouts of different
+versions sharing a root do not delete each other's live caches.
 """
 from __future__ import annotations
 
 import hashlib
 import os
 import shutil
+import time
 from pathlib import Path
 
 from numba.core import caching
@@ -27,6 +33,9 @@ from numba.core import caching
 _CORE = Path(__file__).resolve().parent
 _SOURCES = sorted(_CORE.glob("*.py"))           # the kernels and their config.py
 _PREFIX = "numba-"
+
+#: A cache folder of another version unused this long (days) is removed.
+PRUNE_AFTER_DAYS = 14
 
 
 def source_hash() -> str:
@@ -57,19 +66,54 @@ class _KernelCacheLocator(caching.InTreeCacheLocator):
 
 
 def install() -> None:
-    """Put the locator first in numba's list and prune caches of other versions."""
+    """Put the locator first in numba's list, mark this version's folder as
+    used, and prune folders of other versions unused for PRUNE_AFTER_DAYS."""
     locators = caching.CacheImpl._locator_classes
     if _KernelCacheLocator not in locators:
         locators.insert(0, _KernelCacheLocator)
-    if CACHE_ROOT.is_dir():
-        for entry in CACHE_ROOT.iterdir():
-            stale = (entry.is_dir() and entry.name.startswith(_PREFIX) and entry != CACHE_DIR) \
-                or (entry.suffix in (".nbi", ".nbc") and entry.parent.parent == _CORE)
-            if stale:
-                if entry.is_dir():
+    if not CACHE_ROOT.is_dir():
+        return
+    try:
+        if CACHE_DIR.is_dir():
+            os.utime(CACHE_DIR)
+    except OSError:                       # a read-only install
+        pass
+    cutoff = time.time() - PRUNE_AFTER_DAYS * 86400.0
+    for entry in CACHE_ROOT.iterdir():
+        try:
+            if entry.is_dir() and entry.name.startswith(_PREFIX) and entry != CACHE_DIR:
+                if entry.stat().st_mtime < cutoff:
                     shutil.rmtree(entry, ignore_errors=True)
-                else:
-                    try:
-                        os.remove(entry)
-                    except OSError:
-                        pass
+            elif entry.suffix in (".nbi", ".nbc") and entry.parent.parent == _CORE:
+                os.remove(entry)
+        except OSError:
+            pass
+
+
+def index_entries(cache_dir: Path = None) -> dict:
+    """Compiled versions in a cache folder: {index file name: number of entries}."""
+    import pickle
+    import numba
+    out = {}
+    for path in sorted(Path(cache_dir or CACHE_DIR).glob("*.nbi")):
+        with open(path, "rb") as f:
+            if pickle.load(f) != numba.__version__:
+                continue
+            _stamp, overloads = pickle.loads(f.read())
+        out[path.name] = len(overloads)
+    return out
+
+
+def kernel_versions() -> dict:
+    """Compiled versions of every kernel of workbench.core in this process:
+    {"module.function": number of signatures} for those compiled or loaded."""
+    import importlib
+    from numba.core.registry import CPUDispatcher
+    out = {}
+    for path in _SOURCES:
+        module = importlib.import_module(f"{__package__}.{path.stem}")
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
+                    and obj.signatures:
+                out[f"{path.stem}.{name}"] = len(obj.signatures)
+    return out
