@@ -52,7 +52,7 @@ def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
             status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                                  ydot)
         elif which == 6:
-            project(y, P, free, cg, cw, rg)
+            project(y, P, free, cg, cw, rg, np.bool_(False))
         elif which == 7:
             event_values(y, P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
         else:

@@ -138,7 +138,7 @@ def test_impact_properties(point, seed):
     model, work, y = _impact_setup(p, point, q, qd)
     ke_minus = kinetic_energy(qd, work.mat)
     status, n_pts, lost = impact(y, point, model.P, model.free, work.mat, work.cg, work.cw,
-                                 work.rg, GAP_TOL, np.zeros(ly.N_DOF), 0.0)
+                                 work.rg, GAP_TOL, np.zeros(ly.N_DOF), 0.0, 0.0)
     assert status == ly.OK and int(work.cw[ly.CW_PTS, 0]) == point
     qd_plus = y[ly.N_DOF:ly.N_STATE]
     assert kinetic_energy(qd_plus, work.mat) <= ke_minus * (1 + 1e-12)

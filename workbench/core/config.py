@@ -7,16 +7,34 @@ or ``cache`` flags.  Tolerances used by more than one module live here too.
 #: Options passed to every ``numba.njit`` in :mod:`workbench.core`.
 #: ``error_model="numpy"`` lets division by zero give inf/NaN (caught by the
 #: NaN status check) instead of raising inside the kernel.
-JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+#: ``_nrt=False``: the kernels allocate nothing, so they need no reference
+#: counts; with them, each call of a compiled kernel increments and
+#: decrements every array argument atomically (measured: a call passing 10
+#: arrays 77 ns with the counts, 26 ns without;
+#: docs/performance.md "Compile time").
+JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy", _nrt=False)
+
+#: Kernels that allocate their own work arrays (the static start, not in the
+#: time loop).
+JIT_ALLOC = dict(JIT, _nrt=True)
+
+#: A literal argument (``f(y, 0)``, ``f(y, True)``) or an omitted default
+#: makes numba compile a second version of a kernel for that literal: pass
+#: ``np.int64(0)``, ``np.bool_(True)``, ``np.float64(0.0)`` and give every
+#: argument (tests/core/test_compile.py counts the versions).
 
 #: Smallest pivot accepted by the LDL^T factorisation of the mass matrix,
 #: relative to the largest diagonal entry.
 CHOLESKY_REL_PIVOT = 1e-14
 
-#: Options for small helpers called inside the hot loop: inlined at numba's
-#: IR level, so that calls do not pass the model and work tuples (dozens of
-#: array structs) by value.  Measured: an element's kinematics went from
-#: ~700 ns to ~100 ns (see benchmarks/).
+#: Options for small helpers (a few dozen lines at most, their own inlined
+#: callees included) called inside the time loop: inlined at numba's IR
+#: level, where LLVM would not inline them.  numba types and lowers an inlined
+#: helper again at every call site, so a helper that grows, or calls big ones,
+#: is a kernel of its own (``JIT``): the aggregates of the equations of motion
+#: (rhs, assemble_inertia, frame_sums, add_applied_forces, add_contact_forces,
+#: fill_geometry, ...) are compiled once and called (docs/performance.md
+#: "Compile time").
 JIT_INLINE = dict(JIT, inline="always")
 
 #: Contact event thresholds (docs/model.md §7).  An event function must pass its

@@ -32,6 +32,7 @@ onto any open gap the correction would push past its impact event) and of
 their rates onto the active rows.
 """
 import numba as nb
+import numpy as np
 
 from .config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS
 from . import layout as ly
@@ -179,7 +180,7 @@ def rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
     return ly.OK
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
     """Add the regime's contact forces to the free accelerations in ydot.
 
@@ -257,7 +258,7 @@ def _masked(cg, row, ms, mv, mp):
     return (ms * cg[row, ly.CG_DS], mv * cg[row, ly.CG_DV], mp * cg[row, ly.CG_DPSI])
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def stick_margin(P, free, cg, rg):
     """How far a sticking regime is inside the friction cone (dyn): >= 0 while sticking holds.
 
@@ -351,7 +352,7 @@ def _projection_row(set_index, stick, rows, held, r):
     return -1
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def _project_rows(y, offset, set_index, stick, rows, held, P, free, cg, cw):
     """One least-squares correction of y[offset + (S, V, PSI)] by the given rows.
 
@@ -400,16 +401,16 @@ def _project_gaps(y, set_index, stick, n_normal, held, P, free, cg, cw):
 
     Returns the largest |g| of those gaps before the projection (cm).
     """
-    before = _project_rows(y, 0, set_index, stick, n_normal, held, P, free, cg, cw)
+    before = _project_rows(y, np.int64(0), set_index, stick, n_normal, held, P, free, cg, cw)
     if before > 0.0:
         fill_geometry(y, P, cg)
-        if _project_rows(y, 0, set_index, stick, n_normal, held, P, free, cg, cw) > 0.0:
+        if _project_rows(y, np.int64(0), set_index, stick, n_normal, held, P, free, cg, cw) > 0.0:
             fill_geometry(y, P, cg)
     return before
 
 
 @nb.njit(**JIT)
-def project(y, P, free, cg, cw, rg, hold_open_below=False):
+def project(y, P, free, cg, cw, rg, hold_open_below):
     """Pull the state onto the active constraints of the regime in rg.
 
     Positions: two Newton steps onto the active gaps g = 0 (the gaps are
@@ -438,8 +439,8 @@ def project(y, P, free, cg, cw, rg, hold_open_below=False):
     for p in range(ly.N_POINTS):
         if not in_set(set_index, p) and cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] >= 0.0:
             armed |= 1 << p
-    correction = _project_gaps(y, set_index, stick, n_normal, 0, P, free, cg, cw)
-    held = 0
+    correction = _project_gaps(y, set_index, stick, n_normal, np.int64(0), P, free, cg, cw)
+    held = np.int64(0)
     for p in range(ly.N_POINTS):
         if in_set(set_index, p):
             continue
@@ -452,7 +453,7 @@ def project(y, P, free, cg, cw, rg, hold_open_below=False):
     for r in range(n_normal):
         drift = max(drift, abs(cg[row_geometry_index(set_index, stick, r), ly.CG_VAL]))
     rows = n_normal + (1 if stick else 0)
-    _project_rows(y, ly.N_DOF, set_index, stick, rows, 0, P, free, cg, cw)
+    _project_rows(y, ly.N_DOF, set_index, stick, rows, np.int64(0), P, free, cg, cw)
     return correction, drift
 
 

@@ -46,7 +46,7 @@ def _put(cg, row, val, ds, dv, dp, hss, hsv, hsp, hvv, hvp, hpp):
     r[ly.CG_HPP] = hpp
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def fill_geometry(q, P, cg):
     """Gaps g1..g4 and tangents tau1..tau4 with derivatives (cm, cm/rad, ...) into cg."""
     s = q[ly.S]

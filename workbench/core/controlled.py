@@ -32,6 +32,7 @@ the interval is written to ``floor_log`` (time, regimes, events, estimate).
 Every decision depends on the state only, so a run is deterministic.
 """
 import numba as nb
+import numpy as np
 
 from .config import JIT, JIT_INLINE, MAX_EVENTS_PER_STEP
 from . import layout as ly
@@ -83,7 +84,7 @@ def _restore(base, stages, rg, ev, st, snap):
     return snap[base + ly.SNAP_MISC, 0], int(snap[base + ly.SNAP_MISC, 1])
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def _path(t0, m0, n, h, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
           ev, log, n_log, st):
     """n lattice steps of h (s), the j-th ending at t0 + (m0 + j) h.
@@ -226,7 +227,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
     _floors(P, scale)
     _grow_scales(stages[ly.STAGE_CUR], rg, scale, ctl)
     t = t0
-    stepped_left = 0
+    stepped_left = np.int64(0)
     for i in range(n_steps // seg):
         _save(ly.SNAP_START, t, stepped_left, stages, rg, ev, st, snap)
         k = int(ctl[ly.CTL_LEVEL])

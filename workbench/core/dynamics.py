@@ -94,7 +94,7 @@ def cork_energy(s, P):
     return P[ly.P_CORK_K] * abs(s) ** (n + 1.0) / (n + 1.0) + 0.5 * P[ly.P_K_STOP] * over * over
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def assemble_inertia(q, qd, P, tab, rec, mat, vec):
     """Fill M (mat[MAT_M]), h (vec[VEC_H]) and gravity (vec[VEC_Q]); return V_gravity.
 
@@ -119,7 +119,7 @@ def assemble_inertia(q, qd, P, tab, rec, mat, vec):
     return v_grav
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
     """Add elastic, damping, cork, shaker and hammer forces to Q = vec[VEC_Q].
 
@@ -273,7 +273,7 @@ def solve_free(free, mat, b, x):
     return status
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
     """First-order right-hand side y' = (q', q'') of the 18-state system in free flight.
 

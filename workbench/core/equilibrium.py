@@ -24,7 +24,7 @@ gaps, friction, least potential energy) is decided by
 import numba as nb
 import numpy as np
 
-from .config import JIT, JIT_INLINE
+from .config import JIT, JIT_ALLOC, JIT_INLINE
 from . import layout as ly
 from .contact import fill_geometry
 from .dynamics import add_applied_forces, assemble_inertia, cork_energy
@@ -129,7 +129,7 @@ def _gauss_solve(A, b, x, n):
     return True
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_ALLOC)
 def static_state(z, q_base, coords, points, friction, tip_load, P, tab, kc, free, ex,
                  rec, mat, vec, stages, cg, cw, rg, ev, q, Q, f, energy):
     """The state of unknowns z: q (9,), the force Q with the contact forces (9,), the
@@ -149,7 +149,7 @@ def static_state(z, q_base, coords, points, friction, tip_load, P, tab, kc, free
     energy[3] = tip_y
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_ALLOC)
 def newton_set(z, q_base, coords, points, friction, tip_load, tol, max_iter, max_damped,
                P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """Solve f(z) = 0 from z (overwritten with the solution); returns a status.

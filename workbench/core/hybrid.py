@@ -41,6 +41,7 @@ samples and the log written so far.
 import math
 
 import numba as nb
+import numpy as np
 
 from .config import (ACCUM_GAP_TOL, ACCUM_STEPS, CLOSED_RATE, EVENT_TIME_TOL, GAP_TOL,
                      GRAZE_ITERS, GRAZE_MARGIN, JIT, JIT_INLINE, LAMBDA_EPS,
@@ -97,7 +98,7 @@ def _copy_ev(ev, src, dst):
         ev[dst, i] = ev[src, i]
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY."""
     y = stages[ly.STAGE_CUR]
@@ -389,7 +390,7 @@ def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, r
     reg_from = regime_of(set_index, rg[ly.RG_STICK] != 0.0)
     # The bracketed state is not projected: pull it onto the old regime first,
     # so that e.g. a sticking slip velocity is exactly 0 when slip begins.
-    project(y, P, free, cg, cw, rg)
+    project(y, P, free, cg, cw, rg, np.bool_(False))
     status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
     if status != ly.OK:
         return status
@@ -409,7 +410,7 @@ def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, r
         if status != ly.OK:
             return status
         status, n_pts, lost = impact(y, p, P, free, mat, cg, cw, rg, gap_tol,
-                                     free_acc[ly.N_DOF:ly.N_STATE], close_within)
+                                     free_acc[ly.N_DOF:ly.N_STATE], close_within, np.float64(0.0))
         if status != ly.OK:
             return status
         row = log[_log(log, n_log, t, ly.KIND_IMPACT, reg_from, 0, p + 1)]
@@ -465,7 +466,7 @@ def _immediate_impact(ev):
     return -1
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st):
     """Moreau-Jean steps over h from (t, STAGE_CUR), then the regime chosen at t + h.
 
@@ -490,7 +491,7 @@ def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, 
     return status
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
            out_t, out_y, out_sig):
     y = stages[ly.STAGE_CUR]
@@ -505,7 +506,7 @@ def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, s
     return ly.OK
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, out_t, out_y,
           out_sig, log, st):
     """Start (or continue) a run at t from STAGE_CUR: the regime chosen, its events.
@@ -515,7 +516,7 @@ def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
     """
     y = stages[ly.STAGE_CUR]
     n_log = 0
-    stored = 0
+    stored = np.int64(0)
     reg_start = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
     if step0 == 0:
         st[ly.ST_T_IMPACT] = -1e300
@@ -568,7 +569,7 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
             status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
                               rg, stages[ly.STAGE_NEXT])
             if status == ly.OK:
-                correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg)
+                correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg, np.bool_(False))
                 st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
                 st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
                 status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec,
@@ -654,7 +655,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
     if status != ly.OK:
         return status, stored, n_log
     t = t0
-    stepped_left = 0
+    stepped_left = np.int64(0)
     for step in range(1, n_steps + 1):
         if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
             return ly.LOG_FULL, stored, n_log

@@ -108,7 +108,7 @@ def _combo_impulse(G, u, mu, m, modes, lw, P):
         for r in range(2 * m):
             for c in range(2 * m):
                 g_max = max(g_max, abs(G[r, c]))
-        if not _solve_with_null(A, k, z0, dz, lw[11], g_max):
+        if not _solve_with_null(A, np.int64(k), z0, dz, lw[11], g_max):
             return False
     # P(alpha) = E (z0 + alpha dz): every condition is c + d alpha >= 0
     u_scale = 0.0

@@ -23,7 +23,7 @@ independent reference).
 """
 import numba as nb
 
-from .config import JIT_INLINE
+from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .kinematics import beam_point_motion, tip_row
 
@@ -183,7 +183,7 @@ def _add_frame(acc, f, u, moving, i0, g, M, h, Q):
     return v_grav
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def frame_sums(q, qd, P, tab, rec, M, h, Q):
     """Add every element's M (upper triangle), h and gravity Q; return V_gravity (erg).
 

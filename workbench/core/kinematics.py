@@ -134,7 +134,7 @@ def tip_row(P, which):
     return 2 * int(P[ly.P_N_GAUSS]) + which
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def compute_frames(q, qd, P, tab, rec):
     """Fill the joint-frame and loose-frame records of ``rec``."""
     # Joint frame: origin at beam A's tip; beam A's root frame is global.
@@ -184,7 +184,7 @@ def n_elements(P):
     return 2 * int(P[ly.P_N_GAUSS]) + 3
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def element(k, q, qd, P, tab, rec):
     """Kinematics of mass element ``k`` into ``rec[REC_POINT]``, angle row included.
 

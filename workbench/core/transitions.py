@@ -26,6 +26,7 @@ run statistics.
 import math
 
 import numba as nb
+import numpy as np
 
 from .config import (CLOSED_RATE, GAP_EPS, GAP_TOL, JIT, JIT_INLINE, LAMBDA_EPS, REGIME_REL_TOL,
                      REST_RATE)
@@ -49,7 +50,7 @@ def _compatible(pts, m, p):
 
 
 @nb.njit(**JIT)
-def closed_points(y, point, P, cg, rg, pts, gap_tol, rate_tol, lookahead=0.0):
+def closed_points(y, point, P, cg, rg, pts, gap_tol, rate_tol, lookahead):
     """The points of an impact or regime choice into pts; returns their number (<= 2).
 
     ``point`` first (if >= 0), then the active points of rg, then the open
@@ -89,7 +90,7 @@ def closed_points(y, point, P, cg, rg, pts, gap_tol, rate_tol, lookahead=0.0):
 
 
 @nb.njit(**JIT)
-def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookahead=0.0):
+def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookahead):
     """Momentum transfer at y over the impact set of ``point`` (-1: the closed points).
 
     M and its factor must be current at y.  Updates q' in y and the regime
@@ -105,7 +106,7 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
     energy lost (erg))``.
     """
     pts = cw[ly.CW_PTS]
-    m = closed_points(y, point, P, cg, rg, pts, gap_tol, -1.0, lookahead)
+    m = closed_points(y, point, P, cg, rg, pts, gap_tol, np.float64(-1.0), lookahead)
     if m == 0:
         return ly.OK, 0, 0.0
     qd = y[ly.N_DOF:ly.N_STATE]
@@ -302,7 +303,8 @@ def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
                 if set_index < 0:
                     continue
         if set_index == 0:
-            v = _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, 0, False, 1.0, False)
+            v = _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, np.int64(0), np.bool_(False), 1.0,
+                          np.bool_(False))
             if v < best_v:
                 best_v = v
                 best[0], best[1], best[2] = 0.0, 0.0, 1.0
@@ -365,7 +367,7 @@ def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
             return status
         for j in range(ly.N_DOF):
             a0[j] = ydot[ly.N_DOF + j]
-        m = closed_points(y, -1, P, cg, rg, pts, gap_tol, CLOSED_RATE)
+        m = closed_points(y, np.int64(-1), P, cg, rg, pts, gap_tol, CLOSED_RATE, np.float64(0.0))
         consistent = _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best)
         rg[ly.RG_SET] = best[0]
         rg[ly.RG_STICK] = best[1]
@@ -375,13 +377,13 @@ def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
                 st[ly.ST_N_UNRESOLVED] += 1.0
             break
         # no consistent regime: the impact law at zero approach over the closed points
-        status, n_pts, lost = impact(y, -1, P, free, mat, cg, cw, rg, gap_tol, a0, 0.0)
+        status, n_pts, lost = impact(y, np.int64(-1), P, free, mat, cg, cw, rg, gap_tol, a0, np.float64(0.0), np.float64(0.0))
         if status != ly.OK:
             return status
         st[ly.ST_N_INCONSISTENT] += 1.0
         st[ly.ST_E_INCONSISTENT] += lost
         st[ly.ST_E_IMPACT] += lost
-    project(y, P, free, cg, cw, rg, True)
+    project(y, P, free, cg, cw, rg, np.bool_(True))
     arm_gaps(y, P, cg, rg)
     return rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot)
 
@@ -433,7 +435,7 @@ def moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     for i in range(ly.N_DOF):
         ym[ly.N_DOF + i] += h * k[ly.N_DOF + i]
     rg[ly.RG_SET] = 0.0
-    status, n_pts, lost = impact(ym, -1, P, free, mat, cg, cw, rg, GAP_TOL,
+    status, n_pts, lost = impact(ym, np.int64(-1), P, free, mat, cg, cw, rg, GAP_TOL,
                                  k[ly.N_DOF:ly.N_STATE], h, 0.5 * h)
     if status != ly.OK:
         return status
