@@ -156,13 +156,18 @@ def accuracy_table(b) -> list[str]:
 
 def compile_table(b) -> list[str]:
     rows = ["| fresh process, `workbench run` of the 10 s sine | process wall (s), median | "
-            "rounds | of which the run (s) |", "|---|---|---|---|"]
+            "rounds | of which the run (s) | compiling or loading the kernels (s) | "
+            "kernels cached | versions cached | cache (MB) |", "|---|---|---|---|---|---|---|---|"]
     for cache in ("cold", "warm"):
         bench = b.get(f"test_workbench_run_in_a_fresh_process[{cache}]")
         if bench:
             label = "no cache (compiles)" if cache == "cold" else "warm cache"
+            info = bench["extra_info"]
+            extra = [f"{info['compile_or_load_s']:.2f}", str(info["cache_kernels"]),
+                     str(info["cache_versions"]), f"{info['cache_bytes'] / 1e6:.1f}"] \
+                if "cache_versions" in info else ["", "", "", ""]
             rows.append(f"| {label} | {_median(bench):.2f} | {bench['stats']['rounds']} | "
-                        f"{bench['extra_info']['run_wall_s']:.2f} |")
+                        f"{info['run_wall_s']:.2f} | " + " | ".join(extra) + " |")
     return rows
 
 

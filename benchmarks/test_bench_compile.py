@@ -9,7 +9,9 @@ process: imports, the static start, the run and the output.  "cold": the
 kernels' cache folder (WORKBENCH_CACHE_ROOT) is emptied first, so numba
 compiles everything; "warm": the same folder again, so the kernels are
 loaded from it.  The run's own wall time (``wall_s`` of the JSON) is
-recorded beside it.
+recorded beside it, with the kernels' ``compile_s`` (compiling, or loading
+from the cache), the number of compiled versions in the cache (one per
+kernel: a second version of a kernel is a regression) and the cache's size.
 
 The processes write Python's bytecode cache as on a user's machine: an
 inherited ``PYTHONDONTWRITEBYTECODE`` (set in some shells and containers) is
@@ -23,6 +25,8 @@ import sys
 from pathlib import Path
 
 import pytest
+
+from workbench.core._cache import index_entries
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMAND = ["-m", "workbench", "run", "--gap-mm", "1.016", "--tip-mass", "on", "--cork", "cubic",
@@ -56,7 +60,15 @@ def test_workbench_run_in_a_fresh_process(benchmark, cache_root, cache):
         result.update(_fresh_process(cache_root))
 
     benchmark.pedantic(once, rounds=ROUNDS[cache], iterations=1)
+    entries = {}
+    for folder in cache_root.glob("numba-*"):
+        entries.update(index_entries(folder))
+    size = sum(p.stat().st_size for p in cache_root.rglob("*") if p.is_file())
     benchmark.extra_info.update({"command": "workbench " + " ".join(COMMAND[2:]),
                                  "run_wall_s": result["wall_s"], "status": result["status"],
-                                 "n_events": result["n_events"]})
+                                 "n_events": result["n_events"],
+                                 "compile_or_load_s": result["compile_s"],
+                                 "cache_kernels": len(entries),
+                                 "cache_versions": sum(entries.values()),
+                                 "cache_bytes": size})
     assert result["status"] == "ok"

@@ -596,7 +596,7 @@ def fixed_step_summary(dt: float, steps: int) -> dict:
 
 
 #: What the first compile of the kernels takes (README "Two commands"), for the message.
-COMPILE_NOTE = "about 10 minutes"
+COMPILE_NOTE = "about 2 minutes"
 
 
 def compile_kernel(kernel, args) -> float:
