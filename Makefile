@@ -18,9 +18,10 @@ $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON_SYS) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[dev]'
+	$(PY) -m workbench compile
 	touch $(STAMP)
 
-setup: $(STAMP)  ## create .venv and install the package (editable) with dev extras
+setup: $(STAMP)  ## create .venv, install the package (editable) with dev extras, compile the kernels
 
 test: $(STAMP)  ## run the test suite (physics checks included)
 	$(PY) -m pytest -q

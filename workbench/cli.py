@@ -197,6 +197,20 @@ def _cmd_modes(args) -> int:
     return 0
 
 
+def _cmd_compile(args) -> int:
+    from .core._cache import CACHE_DIR
+    from .model.warmup import compile_all
+    print(f"workbench: compiling the numba kernels into {CACHE_DIR} ({args.jobs} processes)",
+          file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    failed = 0
+    for name, seconds, error in compile_all(args.jobs):
+        print(f"  {name}: {seconds:.0f} s" + (f" FAILED: {error}" if error else ""))
+        failed += bool(error)
+    print(f"  total wall time {time.perf_counter() - t0:.0f} s")
+    return EXIT_INTERNAL if failed else EXIT_OK
+
+
 def _chirp(text: str) -> tuple[float, float, float]:
     parts = text.split(":")
     if len(parts) != 3:
@@ -743,6 +757,12 @@ def build_parser() -> argparse.ArgumentParser:
     dec.add_argument("--beam", choices=("a", "b"), help="give EI and E with this beam's mu, L, I")
     _add_model_options(dec)
     dec.set_defaults(func=_cmd_identify_decrement)
+
+    comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "
+                          "in parallel processes (make setup)")
+    comp.add_argument("--jobs", type=_number(1, 256, integer=True), default=2,
+                      help="processes compiling at once (default 2)")
+    comp.set_defaults(func=_cmd_compile)
 
     params = sub.add_parser("params", help="list every parameter with its unit, range and source")
     _add_model_options(params)
