@@ -3,8 +3,8 @@
 ``workbench/core`` holds numba kernels only: it imports numba, numpy and the
 standard library, never pandas, matplotlib, joblib or the rest of the
 package; every jit decorator takes its options from ``core/config.py``
-(``JIT`` or ``JIT_INLINE``: ``cache=True`` and the error model in one
-place); and the work arrays come in one order everywhere, that of
+(``JIT``, ``JIT_INLINE``, ``JIT_ALLOC`` for the two kernels that allocate,
+``JIT_PARALLEL``: ``cache=True`` and the error model in one place); and the work arrays come in one order everywhere, that of
 :class:`workbench.model.packing.Work` after the model's arrays, so a
 swapped pair (all are 2-D float arrays) cannot compile silently.
 """
@@ -21,7 +21,12 @@ from workbench.model.packing import Model, Work
 CORE = Path(__file__).resolve().parents[2] / "workbench" / "core"
 SOURCES = sorted(CORE.glob("*.py"))
 #: What a kernel module may import (the cache module reaches into numba's caching).
-ALLOWED_IMPORTS = {"numba", "numpy", "math", "__future__", "hashlib", "os", "shutil", "pathlib"}
+ALLOWED_IMPORTS = {"numba", "numpy", "math", "__future__", "hashlib", "os", "shutil", "pathlib",
+                   "time", "pickle", "importlib"}
+#: Calls that allocate an array: only kernels compiled with JIT_ALLOC (reference
+#: counts on) may make them; the others have none (config.JIT).
+ALLOCATING = {"np.zeros", "np.empty", "np.ones", "np.full", "np.array", "np.copy",
+              "np.concatenate", "np.zeros_like", "np.empty_like"}
 #: The one order of the arrays a kernel takes: the model's, the drive, the work's.
 ARGUMENT_ORDER = [*Model._fields, "ex", *Work._fields]
 
@@ -63,9 +68,14 @@ def test_every_jit_decorator_takes_the_config_options():
             where = f"{path.name}:{fn.name}"
             assert isinstance(dec, ast.Call) and not dec.args, where
             assert len(dec.keywords) == 1 and dec.keywords[0].arg is None, where   # **options only
-            assert ast.unparse(dec.keywords[0].value) in ("JIT", "JIT_INLINE", "JIT_PARALLEL"), where
+            options = ast.unparse(dec.keywords[0].value)
+            assert options in ("JIT", "JIT_INLINE", "JIT_ALLOC", "JIT_PARALLEL"), where
+            allocates = any(isinstance(n, ast.Call) and ast.unparse(n.func) in ALLOCATING
+                            for n in ast.walk(fn))
+            assert allocates == (options == "JIT_ALLOC"), f"{where}: allocates {allocates}, {options}"
     assert seen > 50                                   # the kernels were found
     assert config.JIT["cache"] is True and config.JIT_INLINE["cache"] is True
+    assert config.JIT["_nrt"] is False and config.JIT_ALLOC["_nrt"] is True
 
 
 def test_the_kernels_take_their_arrays_in_one_order():
