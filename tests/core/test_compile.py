@@ -9,18 +9,14 @@ import sys
 import textwrap
 
 from workbench.core import _cache
+from workbench.model.warmup import GROUPS
 
-#: A standard workload: controlled runs with impacts and stick-slip (tip on
-#: and off), a fixed-step run, the static start, the signals.
-WORKLOAD = textwrap.dedent("""
+#: A standard workload: the entry points `workbench compile` compiles (the
+#: event loop, both methods; the static start, modes, free flight, hammer),
+#: then the kernels' versions in that process.
+WORKLOAD = "\n".join(textwrap.dedent(code) for code in GROUPS.values()) + textwrap.dedent("""
     import json
     from workbench.core._cache import kernel_versions
-    from workbench.model.excitation import sine
-    from workbench.model.params import Parameters
-    from workbench.model.simulate import simulate
-    for tip in (True, False):
-        simulate(Parameters(tip_mass=tip), sine(200.0, 55.0, 0.1), duration=0.3)
-    simulate(Parameters(), sine(200.0, 20.0), duration=0.05, method="rk4")
     print(json.dumps(kernel_versions()))
 """)
 
