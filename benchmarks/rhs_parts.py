@@ -21,7 +21,7 @@ from workbench.core import layout as ly
 from workbench.core.constrained import project, rhs_regime
 from workbench.core.dynamics import add_applied_forces, assemble_inertia, factor_free, rhs
 from workbench.core.hybrid import event_values
-from workbench.core.integrate import rk4_step
+from workbench.core.integrate import rk_step
 from workbench.model.excitation import sine
 from workbench.model.params import Parameters
 
@@ -56,7 +56,7 @@ def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
         elif which == 7:
             event_values(y, P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
         else:
-            status |= rk4_step(1e-3 * i, y, 1e-5, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+            status |= rk_step(1e-3 * i, y, 1e-5, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
                                cw, rg, stages[ly.STAGE_NEXT])
     return status
 

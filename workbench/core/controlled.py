@@ -22,11 +22,11 @@ doubling).  The fine path is accepted when
   the time of every event, on the scale of the interval's length.
 
 The estimate is Richardson's error of the fine path: the difference of the
-two paths over 2^ORDER - 1 (15 for RK4), which is the fine path's own
-error where the motion is smooth; the largest of these ratios over ``tol``
-decides.  A rejected interval is redone one level finer, the
-fine path becoming the coarse one; an accepted estimate below COARSEN
-lets the next interval try one level coarser.  At ``level_max`` (steps of
+two paths over 2^p - 1 (p the order of the tableau in P: 15 for RK4),
+which is the fine path's own error where the motion is smooth; the largest
+of these ratios over ``tol`` decides.  A rejected interval is redone one
+level finer, the fine path becoming the coarse one; an accepted estimate
+below COARSEN_MARGIN / 2^p lets the next interval try one level coarser.  At ``level_max`` (steps of
 dt / 2^(level_max + 1)) the fine path is accepted whatever the estimate and
 the interval is written to ``floor_log`` (time, regimes, events, estimate).
 Every decision depends on the state only, so a run is deterministic.
@@ -38,13 +38,10 @@ from .config import JIT, JIT_INLINE, MAX_EVENTS_PER_STEP
 from . import layout as ly
 from .contact import regime_of
 from .hybrid import _store, advance, begin
-from .integrate import ORDER
 
-#: Richardson's factor: the difference of the two paths over the fine path's error.
-RICHARDSON = 2.0 ** ORDER - 1.0
-#: An accepted interval whose estimate is below this lets the next one try a
-#: level coarser (a level divides the error by 2^ORDER; with a margin of 2).
-COARSEN = 0.5 / 2.0 ** ORDER
+#: An accepted interval whose estimate is below COARSEN_MARGIN / 2^p (p the
+#: order) lets the next one try a level coarser (a level divides the error by 2^p).
+COARSEN_MARGIN = 0.5
 #: Floors of the error scales: the clearance (cm) for positions (over a
 #: length for angles), and that times REF_RATE (1/s) for velocities.
 REF_RATE = 100.0
@@ -181,7 +178,7 @@ def interval_error(tol, span, a, n_coarse, b, n_fine, P, stages, ev, log, snap, 
         if r > err:
             err = r
             arg = ly.N_STATE + e
-    return err / RICHARDSON, arg
+    return err / (2.0 ** P[ly.P_RK_ORDER] - 1.0), arg     # Richardson's factor
 
 
 @nb.njit(**JIT_INLINE)
@@ -224,6 +221,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
                                   rg, ev, out_t, out_y, out_sig, log, st)
     if status != ly.OK:
         return status, stored, n_log
+    coarsen = COARSEN_MARGIN / 2.0 ** P[ly.P_RK_ORDER]
     _floors(P, scale)
     _grow_scales(stages[ly.STAGE_CUR], rg, scale, ctl)
     t = t0
@@ -291,7 +289,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
         ctl[ly.CTL_INTERVALS] += 1.0
         ctl[ly.CTL_H_MIN] = min(ctl[ly.CTL_H_MIN], h)
         ctl[ly.CTL_H_MAX] = max(ctl[ly.CTL_H_MAX], h)
-        ctl[ly.CTL_LEVEL] = k - 1 if (err < COARSEN and k > 0) else k
+        ctl[ly.CTL_LEVEL] = k - 1 if (err < coarsen and k > 0) else k
         n_log = end_f
         stepped_left = left_f
         t = t0 + (i + 1) * seg * dt

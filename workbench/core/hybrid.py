@@ -1,6 +1,7 @@
 """Event-driven integration of the 17-regime model (docs/model.md §7), jit-compiled.
 
-Fixed RK4 steps in the current regime; after each step the events of the
+Steps of the step method (:func:`workbench.core.integrate.rk_step`, the
+tableau in P) in the current regime; after each step the events of the
 regime are evaluated (every event function goes from + to - when its event
 happens, layout ``EV_*``):
 
@@ -14,7 +15,7 @@ happens, layout ``EV_*``):
     sigma tau' + RATE_EPS                   slip -> stick (or reversal)
 
 A sign change is bracketed by re-integrating the partial step from the
-step's start (one RK4 step of theta dt) and located by Brent's method to
+step's start (one step of theta dt) and located by Brent's method to
 EVENT_TIME_TOL.  A gap that dips below zero and back within one step
 (grazing) is caught by the cubic Hermite interpolant of the gap over the
 step: near its minimum the true gap is evaluated by re-integration and its
@@ -50,7 +51,7 @@ from . import layout as ly
 from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
 from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
 from .dynamics import rhs
-from .integrate import rk4_step
+from .integrate import rk_step
 from .sensors import fill_signals
 from .transitions import choose_regime, impact, moreau_jean_step
 
@@ -103,8 +104,8 @@ def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
     """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY."""
     y = stages[ly.STAGE_CUR]
     y_try = stages[ly.STAGE_TRY]
-    status = rk4_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                      rg, y_try)
+    status = rk_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                     rg, y_try)
     if status == ly.OK:
         status = rhs_regime(t + theta * h, y_try, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
                             rg, stages[ly.STAGE_KTRY])
@@ -156,7 +157,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
     The gap turns within the step (slopes m0 < 0 < m1 per unit theta).  The
     cubic Hermite interpolant of the ends places its minimum, but misplaces
     it by up to ~(omega h)^4 / 384 of the motion when a fast (axial, kHz)
-    oscillation rides on the gap.  So the true gap is evaluated (RK4 from
+    oscillation rides on the gap.  So the true gap is evaluated (a step from
     the step's start) wherever the interpolant comes within GRAZE_MARGIN of
     the slopes of zero, and its minimum is followed by the secant method on
     its rate for up to GRAZE_ITERS trials.  Returns ``(status, theta)``:
@@ -474,7 +475,7 @@ def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, 
     omega h < 2): h is split into the fewest equal steps of at most
     P[P_STEPPED_DT], which the model's fastest linear mode sets
     (:func:`workbench.model.simulate.stepped_dt`); the integration step
-    itself may exceed it (RK4 is stable to omega h = 2.83).
+    itself may exceed it (classical RK4 is stable to omega h = 2.83).
     """
     n = 1
     if h > P[ly.P_STEPPED_DT]:
@@ -566,8 +567,8 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
             break
         e = _immediate_impact(ev)
         if e < 0:
-            status = rk4_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                              rg, stages[ly.STAGE_NEXT])
+            status = rk_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                             rg, stages[ly.STAGE_NEXT])
             if status == ly.OK:
                 correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg, np.bool_(False))
                 st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
@@ -629,7 +630,7 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
 @nb.njit(**JIT)
 def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat, vec, stages,
                cg, cw, rg, ev, out_t, out_y, out_sig, log, st):
-    """Integrate n_steps fixed RK4 steps of dt (s) from (t0, y0) with contact events.
+    """Integrate n_steps fixed steps of dt (s) from (t0, y0) with contact events.
 
     y0 (N_AUG,) is the augmented state; rg holds the starting regime and,
     on return, the final one; STAGE_CUR holds the final state.  ``step0``

@@ -1,12 +1,17 @@
-"""Fixed-step classical Runge-Kutta (RK4) integration, jit-compiled.
+"""The step method: one explicit Runge-Kutta step of the tableau in P, jit-compiled.
 
-One step of size dt advances y by (k1 + 2 k2 + 2 k3 + k4) dt / 6; global
-error O(dt^4).  The state is the augmented one (layout ``A_*``): (q, q')
-and the running integrals of the energy account, so that the account has
-the integrator's accuracy.  :func:`rk4_step` serves both the free-flight
-integration here and the event-driven integration of
-:mod:`workbench.core.hybrid`, which re-integrates partial steps with it.
-Arguments follow :mod:`workbench.core.constrained`; ``stages``
+A step of size dt with s stages advances y by dt sum_i b_i k_i, where
+k_i = f(t + c_i dt, y + dt sum_{j<i} a_ij k_j) (Butcher's tableau, read
+from P at layout ``P_RK_*``; classical RK4 unless the method of the run
+says otherwise, :mod:`workbench.model.tableaus`).  The state is the
+augmented one (layout ``A_*``): (q, q') and the running integrals of the
+energy account, so that the account has the integrator's accuracy.
+:func:`rk_step` is the one step every integrator takes: the free-flight
+integration here, and the event-driven integration of
+:mod:`workbench.core.hybrid`, which re-integrates partial steps with it
+(its interpolant for locating events) and which
+:mod:`workbench.core.controlled` runs twice per interval for its error
+estimate.  Arguments follow :mod:`workbench.core.constrained`; ``stages``
 (N_STAGES, N_AUG) is scratch.
 """
 import math
@@ -17,39 +22,40 @@ from .config import JIT
 from . import layout as ly
 from .constrained import rhs_regime
 
-# Butcher tableau of classical RK4: stage times c, stage weights for the
-# next stage's state, and the final weights b.
-_C = (0.0, 0.5, 0.5, 1.0)
-_A_NEXT = (0.5, 0.5, 1.0)
-_B = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
-#: The order of the step (global error O(dt^ORDER)).
-ORDER = 4
-
 
 @nb.njit(**JIT)
-def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, y_new):
-    """One RK4 step from (t, y) into y_new (may not alias y) in the regime of rg.
+def rk_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, y_new):
+    """One step of the tableau in P from (t, y) into y_new (may not alias y) in the regime of rg.
 
     k1 = f(t, y) must already be in stages[STAGE_K1] (the caller evaluated
-    it, e.g. for the events at the step's start).  Returns a status.
+    it, e.g. for the events at the step's start); k_i goes to stages[i - 1].
+    Zero coefficients a_ij are skipped.  Returns a status.
     """
     n = ly.N_AUG
+    s = int(P[ly.P_RK_STAGES])
     yt = stages[ly.STAGE_TMP]
     for i in range(n):
         stages[0, i] = stages[ly.STAGE_K1, i]
-    for st in range(4):
-        if st > 0:
-            status = rhs_regime(t + _C[st] * dt, yt, P, tab, kc, free, ex, rec, mat, vec,
-                                cg, cw, rg, stages[st])
-            if status != ly.OK:
-                return status
-        if st < 3:
-            h = _A_NEXT[st] * dt
-            for i in range(n):
-                yt[i] = y[i] + h * stages[st, i]
+    for st in range(1, s):
+        row = ly.P_RK_A + ly.MAX_RK_STAGES * st
+        for i in range(n):
+            yt[i] = 0.0
+        for j in range(st):
+            a = P[row + j]
+            if a != 0.0:
+                for i in range(n):
+                    yt[i] += a * stages[j, i]
+        for i in range(n):
+            yt[i] = y[i] + dt * yt[i]
+        status = rhs_regime(t + P[ly.P_RK_C + st] * dt, yt, P, tab, kc, free, ex, rec, mat, vec,
+                            cg, cw, rg, stages[st])
+        if status != ly.OK:
+            return status
     for i in range(n):
-        y_new[i] = y[i] + dt * (_B[0] * stages[0, i] + _B[1] * stages[1, i]
-                                + _B[2] * stages[2, i] + _B[3] * stages[3, i])
+        acc = 0.0
+        for j in range(s):
+            acc += P[ly.P_RK_B + j] * stages[j, i]
+        y_new[i] = y[i] + dt * acc
         if not math.isfinite(y_new[i]):
             return ly.ERR_NAN
     return ly.OK
@@ -58,7 +64,7 @@ def rk4_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
 @nb.njit(**JIT)
 def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, vec,
                     stages, cg, cw, rg, ev, out_t, out_y):
-    """Integrate n_steps RK4 steps of size dt (s) from (t0, y0) in free flight.
+    """Integrate n_steps steps of size dt (s) from (t0, y0) in free flight.
 
     No contact: the loose body passes through the plates, so use it with the
     joint locked or held by springs (docs/model.md §7 contact is in
@@ -86,8 +92,8 @@ def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, 
         status = rhs_regime(t, y_cur, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
                             stages[ly.STAGE_K1])
         if status == ly.OK:
-            status = rk4_step(t, y_cur, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                              rg, y_next)
+            status = rk_step(t, y_cur, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                             rg, y_next)
         if status != ly.OK:
             return status, stored
         for i in range(ly.N_AUG):

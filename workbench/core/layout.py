@@ -65,7 +65,16 @@ P_C_AX_B = 39    # beam B axial damping on u_B (g/s)
 P_S_TRAVEL = 40  # slide before the slot's end stop, each way (cm; inf for none)
 P_K_STOP = 41    # end-stop stiffness beyond |s| > s_travel (g/s^2)
 P_STEPPED_DT = 42  # largest Moreau-Jean step (s); inf until simulate sets it from the model's modes
-N_PARAMS = 43
+# The step method: the explicit Runge-Kutta tableau (Butcher's c, A, b) that
+# every integrator steps with (workbench.core.integrate.rk_step); written by
+# workbench.model.tableaus.write_tableau (classical RK4 by default).
+MAX_RK_STAGES = 6
+P_RK_STAGES = 43   # number of stages s (stored as a float)
+P_RK_ORDER = 44    # order p: global error O(dt^p) (the controller's Richardson factor 2^p - 1)
+P_RK_C = 45        # P_RK_C + i: node c_i (-), i < MAX_RK_STAGES
+P_RK_B = P_RK_C + MAX_RK_STAGES   # P_RK_B + i: weight b_i (-)
+P_RK_A = P_RK_B + MAX_RK_STAGES   # P_RK_A + MAX_RK_STAGES i + j: coefficient a_ij (-), j < i
+N_PARAMS = P_RK_A + MAX_RK_STAGES * MAX_RK_STAGES
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):
@@ -172,19 +181,20 @@ VEC_H, VEC_Q, VEC_RHS, VEC_AUX = 0, 1, 2, 3  # vec (4, 9): h = sum m J^T kappa, 
 AUX_VGRAV, AUX_P_EXT, AUX_F_SHAKER, AUX_F_HAMMER, AUX_P_DAMP = 0, 1, 2, 3, 4   # and scalars of the last rhs:
 N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer forces (dyn),
             # structural damping dissipation (erg/s)
-# stages (N_STAGES, N_AUG): k1..k4, then state buffers.  STAGE_K1 keeps k1 of
+# stages (N_STAGES, N_AUG): the stage derivatives k_1..k_s of a step (rows
+# 0..MAX_RK_STAGES-1), then state buffers.  STAGE_K1 keeps k1 of
 # the current step for re-integrating partial steps; STAGE_TRY and STAGE_HI
 # hold trial states while an event is bracketed (HI: the earliest state
 # found past an event), STAGE_KNEXT and STAGE_KTRY the right-hand sides at
 # STAGE_NEXT and STAGE_TRY; STAGE_QD holds q'- in [0, 9) and a candidate
 # q'+ in [9, 18) during an impact.
-STAGE_TMP, STAGE_CUR, STAGE_NEXT, STAGE_K1, STAGE_TRY, STAGE_HI = 4, 5, 6, 7, 8, 9
-STAGE_KNEXT, STAGE_KTRY, STAGE_QD = 10, 11, 12
-N_STAGES = 13
+(STAGE_TMP, STAGE_CUR, STAGE_NEXT, STAGE_K1, STAGE_TRY, STAGE_HI, STAGE_KNEXT, STAGE_KTRY,
+ STAGE_QD) = range(MAX_RK_STAGES, MAX_RK_STAGES + 9)
+N_STAGES = MAX_RK_STAGES + 9
 
 # --- augmented state -----------------------------------------------------------
 # The integrators carry (q, q') and these running integrals (erg), integrated
-# by the same RK4 steps as the motion, for the energy account.
+# by the same steps as the motion, for the energy account.
 A_WORK = N_STATE        # work of the applied excitation (shaker or hammer)
 A_DAMP = N_STATE + 1    # dissipated by structural damping, int q'^T C q' dt
 A_CORK = N_STATE + 2    # dissipated by the cork damper, int c s'^2 dt

@@ -26,6 +26,7 @@ from ..core import layout as ly
 from ..core.dynamics import fill_stiffness_damping
 from ..core.shapes import fill_shape_row
 from .params import ParameterError, Parameters
+from .tableaus import RK4, write_tableau
 
 #: The loose joint's coordinates; ``fixed=JOINT`` locks the joint.
 JOINT = ("s", "v", "psi")
@@ -82,6 +83,7 @@ def pack(p: Parameters) -> np.ndarray:
     P[ly.P_X_ACCEL1], P[ly.P_X_ACCEL2] = p.x_accel1, p.x_accel2
     # needs the linear eigenvalues, which need this array: workbench.model.simulate sets it
     P[ly.P_STEPPED_DT] = math.inf
+    write_tableau(P, RK4)       # the step method; a run's method may write another
     return P
 
 

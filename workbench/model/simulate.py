@@ -24,6 +24,7 @@ import numpy as np
 from . import packing as mdl
 from ..core import layout as ly
 from .excitation import none
+from .tableaus import write_tableau
 from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
 from .limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD,
                      TOL_RANGE)
@@ -458,6 +459,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
                              "leave excitation unset")
     model = mdl.build(params, fixed)
     model.P[ly.P_STEPPED_DT] = stepped_dt(params)
+    write_tableau(model.P, METHODS[method].tableau)
     work = mdl.make_work()
     try:
         static = static_equilibrium(params, 0.0, fixed)     # the tip's reference position
