@@ -153,3 +153,30 @@ def test_intervals_below_the_floor_are_reported(rocking):
         assert 0 <= row["from_regime"] <= 16 and 0 <= row["to_regime"] <= 16
         assert row["error_over_tol"] is None or row["error_over_tol"] > 1.0
     assert run.summary()["floor_count"] == c["floor_count"]
+
+
+#: The 0.508 mm chirp (studies/chirp.toml) at t = 27.29 s, regime 14, from its run:
+#: 2 ms later an accumulation of impacts floods one step of the finest lattice
+#: (1.56e-6 s) with more than 64 events.
+FLOOD_STATE = (-1.874708104081763, -0.2633982953695513, 0.009218692853584344, 2.0251973709979736,
+               0.025411751438348684, -0.012167639195205292, -1.572727023087652,
+               -0.05412203690518417, 0.0017547322680382706, 1468.581110232601,
+               -27.004095850780867, -25.176870213362285, 64.26100716010392,
+               0.0003617298495454861, -0.18727293069982218, -1047.5824943908224,
+               -16.360306331738915, 87.70494104200556)
+
+
+def test_an_event_flood_is_refined_to_the_floor_and_reported():
+    """Moreau-Jean steps (first order) have no Richardson estimate: an interval whose path
+    took them is refined to the floor and listed there with its steps, never accepted on an
+    estimate (before this rule, these 11 steps were accepted at a coarser level with no
+    floor interval)."""
+    p = Parameters(cork="cubic", tip_mass=True).replace(gap_mm=0.508)
+    run = simulate(p, X.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
+                   initial=np.array(FLOOD_STATE), regime=14, t0=27.29)
+    assert run.ok, run.message
+    stepped = run.summary()["stepped_steps"]
+    flooded = [f for f in run.control["floor_intervals"] if f["moreau_jean_steps"] > 0]
+    assert stepped > 0 and sum(f["moreau_jean_steps"] for f in flooded) == stepped
+    assert all(f["error_over_tol"] is None for f in flooded)
+    assert run.control["h_min"] == pytest.approx(run.dt / 2 ** 6)

@@ -9,7 +9,10 @@ doubling).  The fine path is accepted when
 
 * both paths took the same sequence of events (kind, point, regime after),
   so no impact, separation or stick-slip cycle of one is missing in the
-  other, and
+  other, and neither handed an event flood to Moreau-Jean time-stepping
+  (first order, so Richardson's estimate would not hold: such an interval
+  is refined down to the floor, where the flood is accepted and reported),
+  and
 * every component of (q, q') and every event function of the regime
   (gaps, normal forces, stick margin, slip rate) agrees between the two
   ends within ``tol`` times its scale: for a component of q or q' the
@@ -79,6 +82,12 @@ def _restore(base, stages, rg, ev, st, snap):
     for i in range(ly.N_ST):
         st[i] = snap[base + ly.SNAP_ST, i]
     return snap[base + ly.SNAP_MISC, 0], int(snap[base + ly.SNAP_MISC, 1])
+
+
+@nb.njit(**JIT_INLINE)
+def _took_stepped(st, snap):
+    """Did the path just taken (from snapshot SNAP_START) take Moreau-Jean steps?"""
+    return st[ly.ST_N_STEPPED] != snap[ly.SNAP_START + ly.SNAP_ST, ly.ST_N_STEPPED]
 
 
 @nb.njit(**JIT_INLINE)
@@ -236,7 +245,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
         if status == ly.LOG_FULL:
             _restore(ly.SNAP_START, stages, rg, ev, st, snap)
             return ly.LOG_FULL, stored, n_log
-        coarse_ok = status == ly.OK
+        coarse_ok = status == ly.OK and not _took_stepped(st, snap)
         if coarse_ok:
             _save(ly.SNAP_COARSE, t, left_c, stages, rg, ev, st, snap)
         while True:
@@ -250,7 +259,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
                 _restore(ly.SNAP_START, stages, rg, ev, st, snap)
                 return ly.LOG_FULL, stored, n_log
             err, arg = MISMATCH, -1
-            if status == ly.OK and coarse_ok:
+            if status == ly.OK and coarse_ok and not _took_stepped(st, snap):
                 err, arg = interval_error(tol, seg * dt, n_log, end_c - n_log, end_c,
                                           end_f - end_c, P, stages, ev, log, snap, scale, ctl)
             _move_rows(log, end_c, end_f - end_c, n_log)
@@ -261,7 +270,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
             ctl[ly.CTL_REJECTED] += 1.0
             if arg < 0:
                 ctl[ly.CTL_REJECTED_EVENTS] += 1.0
-            coarse_ok = status == ly.OK
+            coarse_ok = status == ly.OK and not _took_stepped(st, snap)
             if coarse_ok:
                 _save(ly.SNAP_COARSE, t, left_f, stages, rg, ev, st, snap)
             end_c = end_f
@@ -279,6 +288,8 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
                 floor_log[r, ly.FL_TO] = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
                 floor_log[r, ly.FL_EVENTS] = end_f - n_log
                 floor_log[r, ly.FL_ERR] = -1.0 if err >= MISMATCH else err
+                floor_log[r, ly.FL_STEPPED] = (st[ly.ST_N_STEPPED]
+                                               - snap[ly.SNAP_START + ly.SNAP_ST, ly.ST_N_STEPPED])
             ctl[ly.CTL_N_FLOOR] += 1.0
         if err < MISMATCH and err > ctl[ly.CTL_ERR_MAX]:
             ctl[ly.CTL_ERR_MAX] = err

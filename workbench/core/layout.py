@@ -339,10 +339,11 @@ N_CTL = CTL_LEVELS + N_CTL_LEVELS
 SCALE_FLOOR, SCALE_PEAK = 0, 1
 N_SCALE_ROWS = 2
 # Intervals accepted at the floor floor_log (capacity, N_FLOOR): where, the
-# regimes at its ends, the events of its accepted path, and the estimate
-# over the tolerance (-1: the two paths' regime sequences differ).
-FL_T0, FL_T1, FL_FROM, FL_TO, FL_EVENTS, FL_ERR = range(6)
-N_FLOOR = 6
+# regimes at its ends, the events of its accepted path, the estimate over
+# the tolerance (-1: none, the two paths' regime sequences differ or a path
+# took Moreau-Jean steps), and the Moreau-Jean steps of the accepted path.
+FL_T0, FL_T1, FL_FROM, FL_TO, FL_EVENTS, FL_ERR, FL_STEPPED = range(7)
+N_FLOOR = 7
 
 # Signals stored at the output rate (out_sig columns), CGS units.
 SIGNALS = ("force1", "hammer", "strain1", "strain2", "accel1", "accel2", "accel3", "tip_y",

@@ -570,7 +570,8 @@ def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: floa
     floors = [{"t0": float(r[ly.FL_T0]), "t1": float(r[ly.FL_T1]),
                "from_regime": int(r[ly.FL_FROM]), "to_regime": int(r[ly.FL_TO]),
                "events": int(r[ly.FL_EVENTS]),
-               "error_over_tol": None if r[ly.FL_ERR] < 0 else float(r[ly.FL_ERR])}
+               "error_over_tol": None if r[ly.FL_ERR] < 0 else float(r[ly.FL_ERR]),
+               "moreau_jean_steps": int(r[ly.FL_STEPPED])}
               for r in floor_log[:min(n_floor, len(floor_log))]]
     done = ctl[ly.CTL_INTERVALS] > 0
     names = [*Q_COLUMNS, *QD_COLUMNS, *ly.EV_NAMES, "event_time"]
