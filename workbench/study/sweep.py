@@ -206,6 +206,23 @@ def plan(study: Study, results: str | Path = "results", fresh: bool = False,
             "results": str(out)}
 
 
+def sweep(study: Study | str | Path, results: str | Path = "results", jobs: int = 2,
+          scheduler: str | None = None, fresh: bool = False, progress: bool = True) -> pd.DataFrame:
+    """Run a study (a :class:`Study`, or the path of its TOML file) into ``results``.
+
+    The Python form of ``workbench sweep`` without its report: every
+    unfinished point is run (``jobs`` processes, or the Dask cluster at
+    ``scheduler``), and the table of the study's points is returned (one
+    row per point: its settings, status, metrics and the integrator's
+    account; ``results/<name>/points.parquet``).
+    """
+    if not isinstance(study, Study):
+        from .definition import load
+        study = load(study)
+    return run_study(study, results, jobs=jobs, scheduler=scheduler, fresh=fresh,
+                     progress=progress)
+
+
 def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
               scheduler: str | None = None, fresh: bool = False, progress: bool = True) -> pd.DataFrame:
     """Run every unfinished point of the study; return (and write) points.parquet.
