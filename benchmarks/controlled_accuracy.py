@@ -8,7 +8,7 @@ is measured over 0.5-1 s against RK4 at a 64th of the default step (the
 converged solution, whose own error is its difference from a 32nd, printed
 as ``ref_err``): the tip height's largest difference over the converged
 tip's range, the largest difference of a contact code's time share (from
-the event log, ``metrics.contact_shares_of``), and the events in the
+the event log, ``regimes.contact_shares_of``), and the events in the
 window.  Methods: fixed RK4 at the default step, at a half and a quarter of
 it, and the controlled method at each tolerance, with its wall time, its
 lattice steps (accepted and in all) and its own largest error estimate.
@@ -26,7 +26,7 @@ from joblib import Parallel, delayed
 from workbench.model.excitation import chirp, sine
 from workbench.model.params import Parameters
 from workbench.model.simulate import default_dt, simulate
-from workbench.study.metrics import contact_shares_of
+from workbench.model.regimes import contact_shares_of
 
 DURATION_S = 1.0
 RAMP_S = 0.5

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from workbench.experiments import files as F
-from workbench.experiments.compare import compare
+from workbench.present.comparison import compare
 from workbench.experiments.estimate import estimate
 from workbench.experiments.matching import setup_from
 

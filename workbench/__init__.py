@@ -41,7 +41,7 @@ _API = {
     "read": ("experiments.files", "read"), "write": ("experiments.files", "write"),
     "convert": ("experiments.files", "convert"),
     "record_from_run": ("experiments.files", "record_from_run"),
-    "frf": ("experiments.frf", "frf"), "compare": ("experiments.compare", "compare"),
+    "frf": ("experiments.frf", "frf"), "compare": ("present.comparison", "compare"),
 }
 
 __all__ = ["CORK_MODELS", "ParameterError", "Parameters", "__version__", *_API]

@@ -524,7 +524,7 @@ def _cmd_convert(args) -> int:
 
 
 def _cmd_compare(args) -> int:
-    from .experiments.compare import compare
+    from .present.comparison import compare
     from .model import drives
     from .experiments.matching import setup_from
 

@@ -1,6 +1,7 @@
-"""``workbench compare FILE``: a record against the matching simulation (seed §6).
+"""A record against the matching simulation (seed §6): the differences, as tables.
 
-The four comparisons of the paper, as figures, and a table of differences:
+:func:`workbench.present.comparison.compare` (``workbench compare FILE``)
+draws the paper's comparisons from these and writes them:
 
 1. time-history overlay of the sensor channels (Fig. 6);
 2. power spectra of the strains and accelerations (Fig. 7-8);
@@ -28,15 +29,11 @@ The differences (``differences.csv``/``.md``), over the comparison window:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .channels import CHANNELS, kind
-from .files import record_from_run
-from .frf import frf, peak_table, segment_for
-from ..model.params import ParameterError
 from ..identify.contacts import PATCHES, contact_code_series
 from ..study.metrics import CONTACT_CODES, psd, spectral_peaks
 
@@ -115,61 +112,3 @@ def contact_differences(rec_codes: pd.Series, sim_codes: pd.Series) -> pd.DataFr
                  difference=b.get(c, np.nan) - a.get(c, np.nan)) for c in CONTACT_CODES
             if a.get(c, 0.0) > 0 or b.get(c, 0.0) > 0]
     return pd.DataFrame(rows, columns=["code", "share_record", "share_simulation", "difference"])
-
-
-def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
-            threshold=DEFAULT_THRESHOLD_V, seconds: float = 0.5, chirp: bool = False,
-            band: tuple[float, float] | None = None, title: str = "") -> Comparison:
-    """Compare ``record`` with a simulated ``run`` and write figures and tables into ``out``;
-    ``band`` (Hz) limits the FRF peaks to where the drive has force (a chirp's band)."""
-    from ..present import figures as F
-
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    sim = record_from_run(run)
-    sim.index = sim.index + record.index[0]          # the simulation starts with the record
-    rec_w, sim_w = window(record, skip_s), window(sim, skip_s)
-    rec_codes, sim_codes = code_series(rec_w, threshold), code_series(sim_w, DEFAULT_THRESHOLD_V)
-    result = Comparison(signal_differences(rec_w, sim_w), peak_shifts(rec_w, sim_w),
-                        contact_differences(rec_codes, sim_codes), [])
-    sources = {"record": rec_w, "simulation": sim_w}
-    channels = [c for c in SIGNALS if c in record.columns]
-    result.figures += F.save(F.overlay_time_history(sources, channels, title, seconds),
-                             out / "time_history")
-    spectra = [c for c in channels if kind(c) != "force"] or channels
-    result.figures += F.save(F.overlay_spectra(sources, spectra, title), out / "spectra")
-    if not rec_codes.empty:
-        result.figures += F.save(F.code_series_diagrams(
-            {"record": rec_codes, "simulation": sim_codes}, title, seconds), out / "switching")
-    if chirp and "strain1" in record.columns:
-        for name, rec in sources.items():
-            result.figures += F.save(F.spectrogram(rec, f"{title} — {name}"),
-                                     out / f"spectrogram_{name}")
-    responses = [c for c in channels if kind(c) in ("accel", "strain")]
-    if chirp and "force1" in rec_w.columns and responses:
-        try:
-            seg = segment_for(rec_w)
-            tables = {name: frf(rec, responses, segment_s=seg) for name, rec in sources.items()}
-        except ParameterError as exc:
-            result.notes.append(f"FRFs not computed: {exc}")
-        else:
-            f_lo, f_hi = band or (0.0, None)
-            result.frf_peaks = peak_table(tables, responses, f_lo, f_hi)
-            result.figures += F.save(F.frf_figure(tables, responses, f"{title}: H1 against force1",
-                                                  1.2 * f_hi if f_hi else None), out / "frf")
-    _write_tables(result, out, title)
-    return result
-
-
-def _write_tables(result: Comparison, out: Path, title: str) -> None:
-    tables = {"signals": result.signals, "peaks": result.peaks, "contacts": result.contacts}
-    if result.frf_peaks is not None:
-        tables["frf_peaks"] = result.frf_peaks
-    md = [f"# Comparison: {title}", ""] + [f"{note}\n" for note in result.notes]
-    for name, table in tables.items():
-        table.to_csv(out / f"differences_{name}.csv", index=False)
-        md += [f"## {name}", "", table.to_markdown(index=False, floatfmt=".4g") if len(table)
-               else "(none)", ""]
-    md += ["## figures", ""] + [f"- [{p.name}]({p.name})" for p in result.figures
-                               if p.suffix == ".png"]
-    (out / "differences.md").write_text("\n".join(md) + "\n")

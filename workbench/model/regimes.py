@@ -65,3 +65,26 @@ def in_contact(point: int, regime):
     members = np.array([point in s for s in SETS], dtype=np.int8)
     out = members[set_of(np.asarray(regime))]
     return int(out) if out.ndim == 0 else out
+
+
+def regime_time_of(times, to_regime, t0: float, t1: float) -> dict[int, float]:
+    """Time (s) spent in each regime within [t0, t1], from the event times (s) and the
+    regimes they enter (a run's event log; the regime before the first event is not counted)."""
+    out: dict[int, float] = {}
+    for k in range(len(times)):
+        start = max(times[k], t0)
+        end = min(times[k + 1] if k + 1 < len(times) else t1, t1)
+        if end > start:
+            out[int(to_regime[k])] = out.get(int(to_regime[k]), 0.0) + end - start
+    return out
+
+
+def contact_shares_of(times, to_regime, t0: float, t1: float) -> dict[str, float]:
+    """Fraction of [t0, t1] spent in each contact code ("0", "1", ..., "23"), from the event
+    times (s) and the regimes they enter."""
+    share: dict[str, float] = {}
+    for reg, dur in regime_time_of(times, to_regime, t0, t1).items():
+        code = str(contact_code(reg))
+        share[code] = share.get(code, 0.0) + dur
+    total = t1 - t0
+    return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}

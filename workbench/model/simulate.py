@@ -28,9 +28,8 @@ from .tableaus import write_tableau
 from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
 from .limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD,
                      TOL_RANGE)
-from ..study.metrics import contact_shares_of
 from .params import ParameterError, Parameters, check_positive
-from .regimes import contact_code, in_contact, is_stick, set_of
+from .regimes import contact_code, contact_shares_of, in_contact, is_stick, set_of
 from .statics import static_equilibrium, tip_load_for_deflection
 
 if TYPE_CHECKING:

@@ -35,6 +35,8 @@ import math
 import numpy as np
 
 from ..model import regimes
+from ..model.regimes import contact_shares_of, regime_time_of
+from ..model.simulate import CONTACT_STAT_KEYS
 
 CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
 HARMONICS = (0.5, 1.0, 2.0, 3.0)
@@ -113,33 +115,12 @@ def regime_time(events, t0: float, t1: float) -> dict[int, float]:
     return regime_time_of(events.t.to_numpy(), events.to_regime.to_numpy(), t0, t1)
 
 
-def regime_time_of(times, to_regime, t0: float, t1: float) -> dict[int, float]:
-    """:func:`regime_time` of the event times (s) and the regimes they enter."""
-    out: dict[int, float] = {}
-    for k in range(len(times)):
-        start = max(times[k], t0)
-        end = min(times[k + 1] if k + 1 < len(times) else t1, t1)
-        if end > start:
-            out[int(to_regime[k])] = out.get(int(to_regime[k]), 0.0) + end - start
-    return out
-
-
 def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
     """Fraction of [t0, t1] spent in each contact code ("0", "1", ..., "23"), from an event log.
 
     ``events`` has columns t and to_regime (a run's events, or a reference's log).
     """
     return contact_shares_of(events.t.to_numpy(), events.to_regime.to_numpy(), t0, t1)
-
-
-def contact_shares_of(times, to_regime, t0: float, t1: float) -> dict[str, float]:
-    """:func:`contact_shares` of the event times (s) and the regimes they enter."""
-    share: dict[str, float] = {}
-    for reg, dur in regime_time_of(times, to_regime, t0, t1).items():
-        code = str(regimes.contact_code(reg))
-        share[code] = share.get(code, 0.0) + dur
-    total = t1 - t0
-    return {c: v / total for c, v in sorted(share.items())} if total > 0 else {}
 
 
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
@@ -213,7 +194,6 @@ def contact_checks(run) -> dict:
 
     Forces and speeds are read from the stored signals (the output rate).
     """
-    from ..model.simulate import CONTACT_STAT_KEYS
     p = run.params
     out = {key: run.stats[key] for key in CONTACT_STAT_KEYS}
     e_kin = float(run.signals.e_kin.max()) if len(run.signals) else 0.0
