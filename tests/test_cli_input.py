@@ -33,14 +33,14 @@ def _stub(*args, **kwargs):
 
 @pytest.fixture(autouse=True)
 def no_work(monkeypatch, tmp_path):
-    import workbench.experiments.compare
+    import workbench.present.comparison
     import workbench.experiments.estimate
     import workbench.model.simulate
     import workbench.study.sweep
     monkeypatch.setattr(workbench.model.simulate, "simulate", _stub)
     monkeypatch.setattr(workbench.study.sweep, "run_study", _stub)
     monkeypatch.setattr(workbench.experiments.estimate, "estimate", _stub)
-    monkeypatch.setattr(workbench.experiments.compare, "compare", _stub)
+    monkeypatch.setattr(workbench.present.comparison, "compare", _stub)
     monkeypatch.setenv("WORKBENCH_CRASH_DIR", str(tmp_path / "crash"))
     monkeypatch.chdir(tmp_path)
 

@@ -17,7 +17,7 @@ Every subcommand accepts ``--params FILE.toml`` and ``--set NAME=VALUE``
 Exit codes (:data:`EXIT_CODES`): 0 done; 1 a simulation ended with a
 failure status (what it computed is still written); 2 bad input, refused
 before any work, in one line naming the option or key as written; 3 a sweep
-ran but some points failed; 70 an internal error (a bug of ours: one line,
+ran but some points failed; 4 an estimate's fit did not converge; 70 an internal error (a bug of ours: one line,
 the traceback in a file named there); 130 interrupted.
 """
 from __future__ import annotations
@@ -38,16 +38,23 @@ from .study.paths import check_output_dir, check_output_file
 from .model.limits import (DEFAULT_TOL, FREE_DECAY_MAX_CM, MAX_DT, MAX_DURATION_S, MAX_FORCE_N,
                            MAX_OUTPUT_HZ, MIN_DT)
 
+#: The results root every command's default output folder is in (relative to the working
+#: directory, as the Makefile's RESULTS): sweeps and reports under it by study name,
+#: results/identification, results/compare/<file stem>, results/frf/<file stem>.
+RESULTS = Path("results")
+
 EXIT_OK = 0
 EXIT_RUN_FAILED = 1
 EXIT_BAD_INPUT = 2
 #: Exit status of ``workbench sweep`` when the sweep ran but some points failed.
 EXIT_POINTS_FAILED = 3
+EXIT_NOT_CONVERGED = 4
 EXIT_INTERNAL = 70          # sysexits.h EX_SOFTWARE
 EXIT_INTERRUPTED = 130
 EXIT_CODES = {EXIT_OK: "done", EXIT_RUN_FAILED: "a simulation ended with a failure status",
               EXIT_BAD_INPUT: "bad input, refused before any work",
               EXIT_POINTS_FAILED: "a sweep ran but some points failed",
+              EXIT_NOT_CONVERGED: "an estimate's fit did not converge",
               EXIT_INTERNAL: "internal error (traceback written to a file)",
               EXIT_INTERRUPTED: "interrupted"}
 
@@ -194,7 +201,7 @@ def _cmd_modes(args) -> int:
               f"cork {p.cork} (linearised about the undeformed state):")
         for i, f in enumerate(freqs, 1):
             print(f"  mode {i}: {f:12.4f} Hz")
-    return 0
+    return EXIT_OK
 
 
 def _cmd_compile(args) -> int:
@@ -320,14 +327,14 @@ def _cmd_params(args) -> int:
     if args.json:
         print(json.dumps([{k: (str(v) if isinstance(v, float) and not math.isfinite(v) else v)
                           for k, v in row.items()} for row in rows], default=str, indent=1))
-        return 0
+        return EXIT_OK
     print(f"{'name':<11} {'value':>12} {'unit':<18} {'allowed':<16} source")
     for r in rows:
         flag = "  ASSUMPTION" if r["assumption"] else ""
         value = "None" if r["value"] is None else (f"{r['value']:.6g}" if isinstance(r["value"], float)
                                                   else str(r["value"]))
         print(f"{r['name']:<11} {value:>12} {r['unit']:<18} {r['allowed']:<16} {r['source']}{flag}")
-    return 0
+    return EXIT_OK
 
 
 def _cmd_sweep(args) -> int:
@@ -391,6 +398,7 @@ DEFAULT_RAMP_S = 1.0
 
 
 def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") -> None:
+    from .model import drives
     drive = parser.add_argument_group("excitation (one; default none)")
     drive.add_argument("--freq-hz", type=_number(0, lo_open=True), help="sine at force1, frequency (Hz)")
     drive.add_argument("--chirp", type=_chirp, metavar="F0:F1:T", help="linear chirp F0 -> F1 Hz over T s")
@@ -401,8 +409,10 @@ def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") ->
     drive.add_argument("--force-n", type=_number(-MAX_FORCE_N, MAX_FORCE_N),
                        help="shaker amplitude or hammer peak (N); default: see docs/usage.md")
     drive.add_argument("--ramp-s", type=_number(0), help=ramp_help)
-    drive.add_argument("--pulse-s", type=_number(0, lo_open=True), default=1e-3, help="hammer pulse duration (s)")
-    drive.add_argument("--hit-s", type=_number(0), default=0.01, help="hammer pulse start (s)")
+    drive.add_argument("--pulse-s", type=_number(0, lo_open=True), default=drives.DEFAULTS["width_s"],
+                       help="hammer pulse duration (s)")
+    drive.add_argument("--hit-s", type=_number(0), default=drives.DEFAULTS["t_hit_s"],
+                       help="hammer pulse start (s)")
     drive.add_argument("--drive", metavar="KIND",
                        help="any registered drive (workbench/model/drives.py), set by --drive-set")
     drive.add_argument("--drive-set", metavar="KEY=VALUE", action="append", default=[],
@@ -534,7 +544,7 @@ def _cmd_compare(args) -> int:
     if not any(c in record.columns for c in SIGNALS):
         raise ParameterError(f"{args.file}: no signal channel to compare (has "
                              f"{list(record.columns)}; signals: {list(SIGNALS)})")
-    out = check_output_dir("--out", args.out or Path("results") / "compare" / Path(args.file).stem)
+    out = check_output_dir("--out", args.out or RESULTS / "compare" / Path(args.file).stem)
     base = _given(f"--params {args.params}", Parameters.from_toml, args.params) \
         if args.params else None
     setup = setup_from(_record_settings(args, record.attrs["meta"]), record, base)
@@ -547,7 +557,7 @@ def _cmd_compare(args) -> int:
                       "figures": [str(p) for p in result.figures if p.suffix == ".png"],
                       "rms_error_rel": dict(zip(result.signals.channel,
                                                 result.signals.rms_error_rel.round(4)))}))
-    return 0 if run.ok else 1
+    return EXIT_OK if run.ok else EXIT_RUN_FAILED
 
 
 def _cmd_frf(args) -> int:
@@ -566,7 +576,7 @@ def _cmd_frf(args) -> int:
     if args.segment_s > length * (1 + 1e-9):
         raise ParameterError(f"--segment-s {args.segment_s:g}: longer than {args.file} after "
                              f"--skip-s; allowed: (0, {length:g}] s")
-    out = check_output_dir("--out", args.out or Path("results") / "frf" / path.stem)
+    out = check_output_dir("--out", args.out or RESULTS / "frf" / path.stem)
     out.mkdir(parents=True, exist_ok=True)
     table = frf(record, args.response or None, force=args.force, segment_s=args.segment_s,
                 skip_s=args.skip_s)
@@ -585,7 +595,7 @@ def _cmd_frf(args) -> int:
                      "uff": str(out / "frf.uff"),
                      "figures": [str(p) for p in figures if p.suffix == ".png"],
                      "peaks": peak_table.to_dict("records")}))
-    return 0
+    return EXIT_OK
 
 
 def _cmd_estimate(args) -> int:
@@ -614,7 +624,7 @@ def _cmd_estimate(args) -> int:
     print(json_text({"values": fit.values, "intervals_2sigma": fit.intervals, "cost": fit.cost,
                       "simulations": fit.n_simulations, "success": fit.success,
                       "message": fit.message, "wall_s": round(fit.wall_s, 1)}))
-    return 0 if fit.success else 1
+    return EXIT_OK if fit.success else EXIT_NOT_CONVERGED
 
 
 def _cmd_identify_tables(args) -> int:
@@ -626,7 +636,7 @@ def _cmd_identify_tables(args) -> int:
     agree = {title: dict(t.agrees.value_counts()) for title, t in built.items()}
     print(json_text({"markdown": str(paths["md"]), "latex": str(paths["tex"]),
                       "agreement": {k: {str(a): int(n) for a, n in v.items()} for k, v in agree.items()}}))
-    return 0
+    return EXIT_OK
 
 
 def _cmd_identify_decrement(args) -> int:
@@ -638,7 +648,7 @@ def _cmd_identify_decrement(args) -> int:
         beam = dict(mu=mu, length=length, area_moment=inertia)
     d = log_decrement(args.x1, args.xn, args.t1, args.tn, args.n, **beam)
     print(json_text({**d._asdict(), "E_gpa": d.E_gpa}))
-    return 0
+    return EXIT_OK
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -683,7 +693,7 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--scheduler", default=None,
                        help="Dask scheduler address (tcp://host:port): run on that cluster")
     sweep.add_argument("--fresh", action="store_true", help="discard finished points first")
-    sweep.add_argument("--results", default="results", help="results root (default results/)")
+    sweep.add_argument("--results", default=str(RESULTS), help="results root (default results/)")
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
     sweep.add_argument("--no-report", action="store_true",
                        help="skip the figures, tables and report.md")
@@ -693,7 +703,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     report = sub.add_parser("report", help="figures, tables and report.md of a study already run")
     report.add_argument("study", help="study definition (TOML)")
-    report.add_argument("--results", default="results", help="results root (default results/)")
+    report.add_argument("--results", default=str(RESULTS), help="results root (default results/)")
     _add_jobs_option(report, "processes drawing the figures")
     report.set_defaults(func=_cmd_report)
 
@@ -745,7 +755,8 @@ def build_parser() -> argparse.ArgumentParser:
     ident = sub.add_parser("identify", help="the paper's parameter identification (§4)")
     isub = ident.add_subparsers(dest="what", required=True)
     tab = isub.add_parser("tables", help="Tables 3-6 and Appendix B from their raw inputs")
-    tab.add_argument("--out", default="results/identify", help="output folder")
+    tab.add_argument("--out", default=str(RESULTS / "identification"),
+                     help="output folder (default results/identification)")
     tab.add_argument("--no-table6", action="store_true", help="skip Table 6's fits (~40 s)")
     _add_jobs_option(tab, "processes running Table 6's fits")
     tab.set_defaults(func=_cmd_identify_tables)

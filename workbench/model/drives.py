@@ -23,7 +23,8 @@ from . import excitation as X
 from .params import ParameterError
 
 #: Defaults of the settings a drive may leave out (user units).
-DEFAULTS = {"force_n": X.DEFAULT_FORCE_N, "ramp_s": 0.0, "width_s": 1e-3, "t_hit_s": 0.0,
+#: A hammer hits 10 ms into the record, as a lab's pretrigger keeps the record's start quiet.
+DEFAULTS = {"force_n": X.DEFAULT_FORCE_N, "ramp_s": 0.0, "width_s": 1e-3, "t_hit_s": 0.01,
             "deflection_cm": 8.4}
 #: The unit of every setting.
 UNITS = {"force_n": "N", "freq_hz": "Hz", "f0_hz": "Hz", "f1_hz": "Hz", "sweep_s": "s",
