@@ -7,15 +7,12 @@ stopped by the kernel's compiled event functions (``event_values``;
 terminal, + to -), the transition applied by the kernel's own
 ``apply_event`` (projection, Moreau's impact law, regime choice) and a
 restart.  Same model, same transitions: only the integration differs.
+``make bench`` measures its accuracy against cost on the windows of
+``cases.py``; by hand, its speed on a whole run:
 
-    python benchmarks/lsoda_side_by_side.py accuracy /tmp/windows.json 1e-2 1e-3 1e-4
     python benchmarks/lsoda_side_by_side.py speed 1e-3 [--no-tip] [--force 200] [--rounds 3]
 
-``accuracy`` runs the windows saved by ``accuracy_side_by_side.py windows``
-at each rtol (atol = ATOL_REL * rtol), and prints the tip-height error over
-the converged tip's range and the largest contact-share difference, as
-``accuracy_side_by_side.py measure`` does for the kernel.  ``speed`` runs
-the 10 s sine (1.016 mm, 20 Hz, cubic cork, from the static equilibrium)
+``speed`` runs the 10 s sine (1.016 mm, 20 Hz, cubic cork, from the static equilibrium)
 alternately with the kernel's ``simulate`` (its default step) and with
 LSODA at that rtol, and prints both walls (medians) and their ratio.
 """
@@ -216,32 +213,6 @@ class CompiledLSODA:
         return np.array(times), np.array(tips), by_code, n_events
 
 
-def accuracy(path, rtols):
-    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
-    import accuracy_side_by_side as acc
-    with open(path) as f:
-        saved = json.load(f)
-    for name, (params, ex, _, _) in acc.cases().items():
-        w = saved[name]
-        samples = w["t0"] + np.arange(1, round(acc.WINDOW_S * SAMPLE_HZ) + 1) / SAMPLE_HZ
-        for rtol in rtols:
-            solver = CompiledLSODA(params, ex)
-            start = time.perf_counter()
-            try:
-                _, tip, shares, n_events = solver.run(w["t0"], w["t0"] + acc.WINDOW_S,
-                                                      np.array(w["y0"]), w["regime"], rtol, samples)
-            except RuntimeError as exc:
-                print(json.dumps({"case": name, "rtol": rtol, "failed": str(exc)}), flush=True)
-                continue
-            wall = time.perf_counter() - start
-            ref_tip = np.array(w["tip"])[1:]          # the converged run's samples after t0
-            tip_err, share_err = acc.errors(tip, shares, ref_tip, w["shares"])
-            print(json.dumps({"case": name, "rtol": rtol, "wall_per_sim_s": wall / acc.WINDOW_S,
-                              "tip_error_rel": tip_err, "share_error": share_err,
-                              "events": n_events, "converged_events": w["events"],
-                              "nfev": solver.nfev}), flush=True)
-
-
 def speed(rtol, tip_mass=True, force=200.0, rounds=3, duration=10.0):
     p = Parameters(cork="cubic", tip_mass=tip_mass).replace(gap_mm=1.016)
     ex = sine(force, 20.0, ramp_s=1.0)
@@ -268,10 +239,7 @@ def speed(rtol, tip_mass=True, force=200.0, rounds=3, duration=10.0):
 
 
 if __name__ == "__main__":
-    if sys.argv[1] == "accuracy":
-        accuracy(sys.argv[2], [float(a) for a in sys.argv[3:]])
-    else:
-        args = sys.argv[2:]
-        opt = {a: args[i + 1] for i, a in enumerate(args) if a in ("--force", "--rounds")}
-        speed(float(args[0]), tip_mass="--no-tip" not in args,
-              force=float(opt.get("--force", 200.0)), rounds=int(opt.get("--rounds", 3)))
+    args = sys.argv[2:]
+    opt = {a: args[i + 1] for i, a in enumerate(args) if a in ("--force", "--rounds")}
+    speed(float(args[0]), tip_mass="--no-tip" not in args,
+          force=float(opt.get("--force", 200.0)), rounds=int(opt.get("--rounds", 3)))

@@ -3,7 +3,7 @@
     python benchmarks/reference_window.py sine-tip 1e-6 [1e-7 ...]
 
 Runs the case's whole 10 s sine with the kernel to find the window (see
-:func:`side_by_side.window_start`), then the reference under LSODA at each
+:func:`cases.window_start`), then the reference under LSODA at each
 rtol over the 0.25 s window, and prints its wall time, events and errors
 against the kernel on the same window at 2.5e-5 s (a quarter of the default
 step: its own error is about 1e-6 of the tip's range).  A failure is
@@ -12,7 +12,7 @@ printed with its message; the next tolerance still runs.
 import sys
 import time
 
-import side_by_side as sbs
+import cases as sbs
 
 KERNEL_DT = 2.5e-5
 

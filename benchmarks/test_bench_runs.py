@@ -7,7 +7,7 @@ the machine's load of the moment.
 
 * the 10 s sine with and without the tip mass, and the 240 s chirp, whole,
   at the default settings (the controlled method), and the sines at fixed
-  RK4 steps of the default step beside them (benchmarks/side_by_side.py
+  RK4 steps of the default step beside them (benchmarks/cases.py
   holds the cases);
 * accuracy against cost on a 0.25 s window of each sine: the tip height and
   the contact time shares against a converged run (RK4 at CONVERGED_DT),
@@ -18,7 +18,7 @@ the machine's load of the moment.
 """
 import pytest
 
-from side_by_side import (CASES, CONVERGED_DT, controlled_window, fixed_run, full_run,
+from cases import (CASES, CONVERGED_DT, controlled_window, fixed_run, full_run,
                           kernel_window, lsoda_window, window_start)
 from workbench.model.limits import DEFAULT_TOL
 from workbench.model.simulate import default_dt, simulate

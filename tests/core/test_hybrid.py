@@ -20,8 +20,9 @@ from workbench.core.config import GAP_TOL
 from workbench.core.transitions import impact
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.regimes import contact_code, regime_name
-from workbench.model.simulate import (MAX_DEFAULT_DT, NICE_STEPS, STABILITY_MARGIN, default_dt,
-                                      rk4_amplification, simulate)
+from workbench.model.limits import STABILITY_MARGIN
+from workbench.model.simulate import (MAX_DEFAULT_DT, NICE_STEPS, default_dt, rk4_amplification,
+                                      simulate)
 from workbench.model.modes import linear_eigenvalues
 from workbench.model.statics import static_equilibrium
 

@@ -75,8 +75,13 @@ STEPPED_STEPS = 10
 #: A gap that turns within a step is evaluated where its Hermite interpolant
 #: comes within this fraction of its change of slope (m1 - m0) of zero ...
 GRAZE_MARGIN = 0.02
-#: ... and its minimum followed for at most this many trial states.
+#: ... and its minimum followed for at most this many trial states, while the
+#: secant's bracket on the step's fraction is wider than GRAZE_BRACKET.
 GRAZE_ITERS = 4
+GRAZE_BRACKET = 1e-9
+#: What is left of a step below this fraction of the lattice step is none
+#: (the round-off of t + h, not time to integrate).
+STEP_REMAINDER_REL = 1e-15
 
 # --- transitions -----------------------------------------------------------
 #: A point whose gap is within this of zero (cm) is closed or closing: it joins

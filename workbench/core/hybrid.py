@@ -45,8 +45,8 @@ import numba as nb
 import numpy as np
 
 from .config import (ACCUM_GAP_TOL, ACCUM_STEPS, CLOSED_RATE, EVENT_TIME_TOL, GAP_TOL,
-                     GRAZE_ITERS, GRAZE_MARGIN, JIT, JIT_INLINE, LAMBDA_EPS,
-                     MAX_EVENTS_PER_STEP, RATE_EPS, STEPPED_STEPS)
+                     GRAZE_BRACKET, GRAZE_ITERS, GRAZE_MARGIN, JIT, JIT_INLINE, LAMBDA_EPS,
+                     MAX_EVENTS_PER_STEP, RATE_EPS, STEP_REMAINDER_REL, STEPPED_STEPS)
 from . import layout as ly
 from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
 from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
@@ -187,7 +187,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
             lo_x, lo_r = x, r
         else:
             hi_x, hi_r = x, r
-        if hi_r - lo_r <= 0.0 or hi_x - lo_x <= 1e-9:
+        if hi_r - lo_r <= 0.0 or hi_x - lo_x <= GRAZE_BRACKET:
             return ly.OK, -1.0
         x = lo_x - lo_r * (hi_x - lo_x) / (hi_r - lo_r)
     return ly.OK, -1.0
@@ -563,7 +563,7 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
         t = t_end
     while stepped_left == 0:
         h = t_end - t
-        if h <= 1e-15 * dt:
+        if h <= STEP_REMAINDER_REL * dt:
             break
         e = _immediate_impact(ev)
         if e < 0:
@@ -602,7 +602,7 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
                 # an episode the event-driven logic cannot resolve: Moreau-Jean
                 # time-stepping through the rest of this step and STEPPED_STEPS more
                 status = ly.OK
-                if t_end - t > 1e-15 * dt:
+                if t_end - t > STEP_REMAINDER_REL * dt:
                     status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages,
                                       cg, cw, rg, ev, st)
                 if status != ly.OK:

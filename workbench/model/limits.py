@@ -30,3 +30,7 @@ STEPS_PER_PERIOD = 20
 MIN_PULSE_STEPS = 5
 #: The longest study name (it names a folder).
 MAX_NAME_CHARS = 100
+
+#: :func:`workbench.model.simulate.default_dt` asks RK4 to be stable for every eigenvalue of the
+#: linear model scaled by this factor: room for the stiffening of contact.
+STABILITY_MARGIN = 1.25

@@ -26,8 +26,8 @@ from ..core import layout as ly
 from .excitation import none
 from .tableaus import write_tableau
 from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
-from .limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STEPS_PER_PERIOD,
-                     TOL_RANGE)
+from .limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STABILITY_MARGIN,
+                     STEPS_PER_PERIOD, TOL_RANGE)
 from .params import ParameterError, Parameters, check_positive
 from .regimes import contact_code, contact_shares_of, in_contact, is_stick, set_of
 from .statics import static_equilibrium, tip_load_for_deflection
@@ -39,9 +39,6 @@ DEFAULT_OUTPUT_HZ = 1000.0
 #: Steps :func:`default_dt` chooses from (s): 1 ms / n for n = 10 ... 200, so that each
 #: divides 1 ms (every output rate that divides 1 kHz, and every whole number of ms).
 NICE_STEPS = tuple(1e-3 / n for n in range(10, 201))
-#: :func:`default_dt` asks RK4 to be stable for every eigenvalue of the
-#: linear model scaled by this factor: room for the stiffening of contact.
-STABILITY_MARGIN = 1.25
 #: The largest default step (s): on the benchmark windows at 1e-4 s the tip
 #: height is within 2.6e-5 of its range and the contact time shares within
 #: 5e-6 of a converged run (docs/performance.md).
