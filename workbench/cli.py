@@ -585,9 +585,9 @@ def _cmd_frf(args) -> int:
     peak_table = peak_table_of({args.file: table}, responses, args.f_min,
                                args.f_max).drop(columns="source")
     peak_table.to_csv(out / "peaks.csv", index=False)
-    (out / "peaks.md").write_text("# FRF peaks (H1): frequency, magnitude, coherence, half-power "
-                                  "damping ratio\n\n" + peak_table.to_markdown(index=False, floatfmt=".4g")
-                                  + "\n")
+    (out / "peaks.md").write_text("# FRF peaks (H1): frequency (Hz), magnitude in its unit, "
+                                  "coherence, half-power damping ratio\n\n"
+                                  + peak_table.to_markdown(index=False, floatfmt=".4g") + "\n")
     figures = save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against "
                               f"{args.force}", args.f_max), out / "frf")
     uff.write_frf(out / "frf.uff", table, responses, args.force, meta=meta)

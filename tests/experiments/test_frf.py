@@ -42,6 +42,14 @@ def test_h1_of_a_single_degree_of_freedom_matches_its_receptance():
     top = peaks(table, "accel1", 5.0, 60.0)
     assert len(top) == 1 and top.f_hz[0] == pytest.approx(fn, abs=0.1)
     assert top.zeta_half_power[0] == pytest.approx(zeta, rel=0.25)
+    # the record is CGS ((cm/s^2) per dyn); the peak is given in the field's (m/s^2)/N
+    k = np.argmin(np.abs(f - top.f_hz[0]))
+    assert top.unit[0] == "(m/s²)/N"
+    assert top.magnitude[0] == pytest.approx(abs(table.accel1_H1.iloc[k]) * 1e5 / 100.0)
+    strain = peaks(table.rename(columns=lambda c: c.replace("accel1", "strain1")), "strain1",
+                   5.0, 60.0)
+    assert strain.unit[0] == "µε/N"
+    assert strain.magnitude[0] == pytest.approx(abs(table.accel1_H1.iloc[k]) * 1e11)
 
 
 def test_noise_on_the_response_lowers_the_coherence_and_separates_h1_from_h2():

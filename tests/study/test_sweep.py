@@ -12,7 +12,7 @@ import pytest
 
 from workbench.study import definition as S
 from workbench.study import sweep as W
-from workbench.present.report import make_report
+from workbench.present.report import make_report, series_tags
 from workbench.model.params import ParameterError
 from workbench.study.store import read_runs
 
@@ -155,7 +155,7 @@ def test_an_unstable_point_is_recorded_as_failed(tmp_path, monkeypatch):
     make_report(S.load(tmp_path / "study.toml"), tmp_path / "res")
     out = tmp_path / "res" / "small"
     assert pd.read_csv(out / "tables" / "response.csv").status.tolist() == ["failed"]
-    assert (out / "figures" / f"time_history_{table.key.iloc[0][:8]}.png").exists()
+    assert (out / "figures" / f"time_history_{series_tags(table)[0]}.png").exists()
 
 
 def test_stepped_sweep_carries_the_state(tmp_path):
@@ -227,7 +227,8 @@ def test_report_figures_and_tables_of_a_grid(small_run):
     study, root, table = small_run
     out = root / "res1" / "small"
     index = make_report(study, root / "res1")
-    tag = table[(table.axis_gap_mm == 1.016) & (table.axis_freq_hz == 20.0)].key.iloc[0][:8]
+    tag = "gap-1.016mm_drive-frequency-20hz"
+    assert tag in series_tags(table)
     expected = ["frf_map_tip", "frf_map_strain1", "response_curves", "regime_shares",
                 "bifurcation", f"time_history_{tag}", f"strain_spectra_{tag}", f"switching_{tag}"]
     for name in expected:
@@ -307,11 +308,12 @@ gap_mm = [1.016]
     assert table.status.tolist() == ["ok"] and "tip_poincare" not in table
     make_report(study, tmp_path / "res")
     out = tmp_path / "res" / "chirp"
-    assert (out / "figures" / f"spectrogram_{table.key.iloc[0][:8]}.png").exists()
+    assert (out / "figures" / "spectrogram_gap-1.016mm.png").exists()
+    assert "### spectrogram — gap 1.016 mm" in (out / "report.md").read_text()
     assert not (out / "figures" / "frf_map_tip.png").exists()     # no gap x frequency grid
     long = pd.read_csv(out / "tables" / "response.csv")
     assert long.tip_rms.iloc[0] == pytest.approx(table.tip_rms.iloc[0], rel=1e-12)
-    assert (out / "figures" / f"frf_{table.key.iloc[0][:8]}.png").exists()
+    assert (out / "figures" / "frf_gap-1.016mm.png").exists()
     peaks = pd.read_csv(out / "tables" / "frf_peaks.csv")
     assert set(peaks.response) <= {"strain1", "accel1", "accel2", "strain2", "accel3"}
     assert len(peaks) > 0 and peaks.f_hz.between(5.0, 65.0).all()       # the chirp's band
@@ -418,3 +420,15 @@ def test_the_code_version_covers_the_kernels_and_the_model_not_the_presentation(
         assert computing in names
     for presenting in ("present/figures.py", "experiments/files.py", "cli.py"):
         assert presenting not in names
+
+
+def test_a_run_left_running_by_a_dead_process_is_marked_interrupted(tmp_path):
+    """runs.json of a sweep killed by SIGKILL says "running"; the next sweep (which holds
+    the study's lock, so no sweep of it is alive) marks that entry interrupted."""
+    from workbench.study.store import StudyLock, log_run, read_runs
+    (tmp_path / "runs.json").write_text('[{"started": "then", "state": "running", "pid": 1},'
+                                        ' {"started": "before", "state": "done"}]')
+    with StudyLock(tmp_path):
+        index = log_run(tmp_path, {"started": "now", "state": "running"})
+    runs = read_runs(tmp_path)
+    assert index == 2 and [r["state"] for r in runs] == ["interrupted", "done", "running"]

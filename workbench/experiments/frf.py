@@ -27,9 +27,23 @@ import pandas as pd
 from scipy import signal
 
 from ..model.params import ParameterError
+from .channels import kind
 
 #: Default segment length (s): 0.5 Hz resolution, enough to separate the modes.
 DEFAULT_SEGMENT_S = 2.0
+#: The field's unit of an FRF's magnitude, by the response's kind, and its factor from the
+#: record's CGS ratio (strain per dyn, (cm/s^2) per dyn): 1 N = 1e5 dyn, 1 = 1e6 microstrain,
+#: 1 m/s^2 = 100 cm/s^2.
+FIELD_UNITS = {"strain": ("µε/N", 1e6 * 1e5), "accel": ("(m/s²)/N", 1e5 / 100.0)}
+
+
+#: The columns of a response's peak table.
+PEAK_COLUMNS = ["f_hz", "magnitude", "unit", "coherence", "zeta_half_power"]
+
+
+def field_unit(response: str) -> tuple[str, float]:
+    """(unit, factor from CGS) of the FRF magnitude of a response channel (strain or accel)."""
+    return FIELD_UNITS[kind(response)]
 
 
 def frf(record: pd.DataFrame, responses=None, force: str = "force1",
@@ -92,8 +106,9 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
 
 def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: float | None = None,
           prominence: float = 0.1, estimate: str = "H1") -> pd.DataFrame:
-    """The resonance peaks of |H| of one response: frequency (Hz), |H|, coherence, and the
-    half-power damping ratio (NaN where a half-power point lies outside the band).
+    """The resonance peaks of |H| of one response: frequency (Hz), |H| in the field's unit
+    (:data:`FIELD_UNITS`) and that unit, coherence, and the half-power damping ratio (NaN
+    where a half-power point lies outside the band).
 
     ``prominence`` is relative to the largest |H| in the band (log scale: a
     peak must stand out by that fraction of a decade)."""
@@ -102,8 +117,9 @@ def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: flo
     mag = np.abs(frf_table[f"{response}_{estimate}"].to_numpy())[band]
     coh = frf_table[f"{response}_coherence"].to_numpy()[band]
     fb = f[band]
+    unit, scale = field_unit(response)
     if not np.any(mag > 0):
-        return pd.DataFrame(columns=["f_hz", "magnitude", "coherence", "zeta_half_power"])
+        return pd.DataFrame(columns=PEAK_COLUMNS)
     logm = np.log10(np.where(mag > 0, mag, mag[mag > 0].min()))
     idx, _ = signal.find_peaks(logm, prominence=prominence)
     rows = []
@@ -120,18 +136,19 @@ def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: flo
             fa = np.interp(level, [mag[lo], mag[lo + 1]], [fb[lo], fb[lo + 1]])
             fbb = np.interp(level, [mag[hi], mag[hi - 1]], [fb[hi], fb[hi - 1]])
             zeta = (fbb - fa) / (2.0 * fb[i])
-        rows.append({"f_hz": float(fb[i]), "magnitude": float(mag[i]),
+        rows.append({"f_hz": float(fb[i]), "magnitude": float(mag[i]) * scale, "unit": unit,
                      "coherence": float(coh[i]), "zeta_half_power": float(zeta)})
-    return pd.DataFrame(rows, columns=["f_hz", "magnitude", "coherence", "zeta_half_power"])
+    return pd.DataFrame(rows, columns=PEAK_COLUMNS)
 
 
 def peak_table(tables: dict[str, pd.DataFrame], responses, f_min: float = 0.0,
                f_max: float | None = None) -> pd.DataFrame:
     """The H1 peaks of each response of each FRF table ({source: table}), one row per
-    peak: source, response, f_hz, magnitude, coherence, zeta_half_power."""
+    peak: source, response, f_hz, magnitude and its unit (the field's, :data:`FIELD_UNITS`),
+    coherence, zeta_half_power."""
     rows = [peaks(table, r, f_min, f_max).assign(source=source, response=r)
             for source, table in tables.items() for r in responses]
-    columns = ["source", "response", "f_hz", "magnitude", "coherence", "zeta_half_power"]
+    columns = ["source", "response", *PEAK_COLUMNS]
     rows = [r for r in rows if len(r)]
     return pd.concat(rows, ignore_index=True)[columns] if rows else pd.DataFrame(columns=columns)
 
@@ -149,11 +166,13 @@ def responses_of(table: pd.DataFrame) -> list[str]:
 
 
 def magnitude_phase(table: pd.DataFrame) -> pd.DataFrame:
-    """An FRF table in real columns: |H1|, |H2|, their phases (deg) and the coherence."""
+    """An FRF table in real columns: |H1|, |H2| in the field's units (the unit in the
+    column's name: ``strain1_H1_abs [µε/N]``), their phases (deg) and the coherence."""
     flat = pd.DataFrame(index=table.index)
     for r in responses_of(table):
+        unit, scale = field_unit(r)
         for est in ("H1", "H2"):
-            flat[f"{r}_{est}_abs"] = table[f"{r}_{est}"].abs()
+            flat[f"{r}_{est}_abs [{unit}]"] = table[f"{r}_{est}"].abs() * scale
             flat[f"{r}_{est}_phase_deg"] = np.degrees(np.angle(table[f"{r}_{est}"]))
         flat[f"{r}_coherence"] = table[f"{r}_coherence"]
     return flat

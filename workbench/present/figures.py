@@ -34,6 +34,7 @@ from scipy import signal as sps  # noqa: E402
 
 from ..study.metrics import CONTACT_CODES, QUANTITIES, psd  # noqa: E402
 from ..study.grid import label, panels  # noqa: E402
+from ..experiments.frf import field_unit  # noqa: E402
 
 CODE_COLORS = dict(zip(CONTACT_CODES, plt.get_cmap("tab10").colors))
 SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
@@ -42,9 +43,10 @@ SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
 
 
 def save(fig, path: Path) -> list[Path]:
-    """Write ``fig`` as ``path``.png and ``path``.pdf; return both paths."""
+    """Write ``fig`` as ``path``.png and ``path``.pdf; return both paths.  The suffixes are
+    appended: a name may hold dots ("spectrogram_gap-1.016mm")."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    out = [path.with_suffix(".png"), path.with_suffix(".pdf")]
+    out = [path.with_name(path.name + ".png"), path.with_name(path.name + ".pdf")]
     for p in out:
         fig.savefig(p, dpi=120, bbox_inches="tight")
     plt.close(fig)
@@ -317,21 +319,22 @@ def frf_figure(tables, responses, title: str, f_max: float | None = None):
         for source, table in sources.items():
             f = table.index.to_numpy()
             band = (f > 0) & (f <= (f_max if f_max is not None else f[-1]))
+            unit, scale = field_unit(r)
             h1 = table[f"{r}_H1"].to_numpy()[band]
             name = f"{source} H1".strip()
-            axes[0, j].semilogy(f[band], np.abs(h1), label=name, lw=0.9)
+            axes[0, j].semilogy(f[band], np.abs(h1) * scale, label=name, lw=0.9)
             if single:
-                axes[0, j].semilogy(f[band], np.abs(table[f"{r}_H2"].to_numpy()[band]),
+                axes[0, j].semilogy(f[band], np.abs(table[f"{r}_H2"].to_numpy()[band]) * scale,
                                     label="H2", alpha=0.7, lw=0.9)
             axes[1, j].plot(f[band], np.degrees(np.angle(h1)), lw=0.8, label=name)
             axes[2, j].plot(f[band], table[f"{r}_coherence"].to_numpy()[band], lw=0.8,
                             label=source or None)
         axes[0, j].set_title(r, fontsize=9)
+        axes[0, j].set_ylabel(f"|H| ({field_unit(r)[0]})")
         axes[0, j].legend(fontsize=8)
         axes[0, j].grid(alpha=0.3, which="both")
         axes[2, j].set_ylim(0, 1.05)
         axes[2, j].set_xlabel("frequency (Hz)")
-    axes[0, 0].set_ylabel("|H| (response unit / force unit)")
     axes[1, 0].set_ylabel("phase H1 (deg)")
     axes[2, 0].set_ylabel("coherence")
     fig.suptitle(title, fontsize=10)

@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import figures as F
-from ..study.grid import point_title
+from ..study.grid import point_slug, point_title
 from ..study.provenance import environment
 from ..study.store import read_runs, write_text_atomic
 from ..model import drives
@@ -53,9 +53,9 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     return figs
 
 
-def _series_figures(study: Study, row, out: Path, frf_peaks: list):
-    """(name, figure builder) of one point's saved series (none if it has no series);
-    a chirp's FRF peaks are added to ``frf_peaks``."""
+def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
+    """(name, figure builder) of one point's saved series (none if it has no series),
+    each name ``<figure>_<tag>``; a chirp's FRF peaks are added to ``frf_peaks``."""
     path = out / "series" / f"{row.key}.parquet"
     if not path.exists():
         return
@@ -67,7 +67,6 @@ def _series_figures(study: Study, row, out: Path, frf_peaks: list):
         title += f", {row.direction} sweep"
     if row.status != "ok":                     # what was computed before the failure
         title += f" — {row.status} at t = {t_end:.2f} s"
-    tag = row.key[:8]
     short = min(0.5, study.window_s)
     yield f"time_history_{tag}", lambda: F.time_history(sig, row.static_tip_y, title, short)
     yield f"strain_spectra_{tag}", lambda: F.strain_spectra(sig, title, study.window_s)
@@ -87,15 +86,37 @@ def _series_figures(study: Study, row, out: Path, frf_peaks: list):
 _DRAW_COST = {"regime_shares": 4.0, "bifurcation": 3.0}
 
 
+def series_tags(table: pd.DataFrame) -> list[str]:
+    """Each point's part of its figures' names: its axis values ("gap-1.016mm_tip-mass-on",
+    :func:`~workbench.study.grid.point_slug`), a stepped sweep's direction, and the
+    point's key where two points would share a name."""
+    tags = []
+    for _, row in table.iterrows():
+        tag = point_slug(row) or "point"
+        tags.append(f"{tag}_{row.direction}" if getattr(row, "direction", "") else tag)
+    shared = {t for t in tags if tags.count(t) > 1}
+    return [f"{t}_{key[:8]}" if t in shared else t for t, key in zip(tags, table.key)]
+
+
+def heading(name: str, table: pd.DataFrame, tags: list[str]) -> str:
+    """A figure's heading in the report: what it shows, and for which point."""
+    for tag, (_, row) in zip(tags, table.iterrows()):
+        if name.endswith(f"_{tag}"):
+            title = point_title(row) + (f", {row.direction} sweep" if row.direction else "")
+            return f"{name[:-len(tag) - 1].replace('_', ' ')} — {title}"
+    return name.replace("_", " ")
+
+
 def _draw(study: Study, table: pd.DataFrame, out: Path, unit) -> tuple[dict, list]:
     """Draw and save one unit of the report: a grid figure (its name) or the
-    figures of one point's series (its row number).  Returns the figures
-    made {name: paths} and the FRF peak tables."""
+    figures of one point's series (its row number and tag).  Returns the
+    figures made {name: paths} and the FRF peak tables."""
     frf_peaks: list = []
     if isinstance(unit, str):
         builders = [(unit, _grid_figures(study, table)[unit])]
     else:
-        builders = _series_figures(study, table.iloc[unit], out, frf_peaks)
+        row, tag = unit
+        builders = _series_figures(study, table.iloc[row], tag, out, frf_peaks)
     made = {name: F.save(build(), out / "figures" / name) for name, build in builders}
     return made, frf_peaks
 
@@ -109,8 +130,10 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
     out = Path(results) / study.name
     table = pd.read_parquet(out / "points.parquet")
     t0 = time.perf_counter()
+    tags = series_tags(table)
     units = list(_grid_figures(study, table)) + [
-        i for i, key in enumerate(table.key) if (out / "series" / f"{key}.parquet").exists()]
+        (i, tags[i]) for i, key in enumerate(table.key)
+        if (out / "series" / f"{key}.parquet").exists()]
     if jobs > 1 and len(units) > 1:
         from joblib import Parallel, delayed
         # the many-panel grid figures first, so that the processes finish
@@ -202,5 +225,6 @@ def render_index(study, table, figures, tables, out) -> str:
     lines += ["", "## Figures", ""]
     for name, paths in figures.items():
         png, pdf = (p.relative_to(out) for p in paths)
-        lines += [f"### {name}", "", f"![{name}]({png}) ([PDF]({pdf}))", ""]
+        lines += [f"### {heading(name, table, series_tags(table))}", "",
+                  f"![{name}]({png}) ([PDF]({pdf}))", ""]
     return "\n".join(lines) + "\n"

@@ -112,7 +112,8 @@ def write_frf_peaks(peaks: pd.DataFrame, out: Path) -> list[Path]:
     """The FRF peaks of a study's chirps (``frf_peaks.{csv,md,tex}``); return the paths."""
     out.mkdir(parents=True, exist_ok=True)
     peaks = peaks.rename(columns={"source": "point"})
-    caption = "FRF peaks (H1 against force1): frequency (Hz), |H1|, coherence, half-power damping ratio"
+    caption = ("FRF peaks (H1 against force1): frequency (Hz), |H1| in its unit (µε/N, (m/s²)/N), "
+               "coherence, half-power damping ratio")
     paths = [out / f"frf_peaks.{ext}" for ext in ("csv", "md", "tex")]
     peaks.to_csv(paths[0], index=False)
     paths[1].write_text(f"# {caption}\n\n{peaks.to_markdown(index=False, floatfmt='.4g')}\n")

@@ -44,3 +44,17 @@ def panels(table: pd.DataFrame, exclude: tuple[str, ...]) -> list[tuple[str, pd.
 def point_title(row) -> str:
     """'gap 1.016 mm, drive frequency 20 Hz, ...' from a points-table row's axis values."""
     return ", ".join(axis_text(k[5:], v) for k, v in row.items() if k.startswith("axis_"))
+
+
+def point_slug(row) -> str:
+    """'gap-1.016mm_tip-mass-on' from a points-table row's axis values: a file name
+    that says which point it is (:func:`point_title` in lower case, without spaces)."""
+    parts = []
+    for k, v in row.items():
+        if k.startswith("axis_"):
+            text = axis_text(k[5:], v)
+            for unit in (" mm", " hz", " n", " s"):
+                if text.lower().endswith(unit):
+                    text = text[:-len(unit)] + unit.strip()
+            parts.append(text.lower().replace(" ", "-").replace("/", "-"))
+    return "_".join(parts)

@@ -82,8 +82,16 @@ def read_runs(out: Path) -> list:
 
 
 def log_run(out: Path, entry: dict) -> int:
-    """Append an entry to runs.json; return its index (for :func:`update_run`)."""
+    """Append an entry to runs.json; return its index (for :func:`update_run`).
+
+    Called under the study's :class:`StudyLock`: an earlier entry still
+    "running" belongs to a sweep whose process is gone (killed before it
+    could close its entry), and is marked "interrupted".
+    """
     runs = read_runs(out)
+    for run in runs:
+        if run.get("state") == "running":
+            run.update(state="interrupted", note="its process ended without closing this entry")
     write_text_atomic(json.dumps(runs + [entry], indent=1) + "\n", out / "runs.json")
     return len(runs)
 
