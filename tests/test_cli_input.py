@@ -281,6 +281,27 @@ def _merge(base, lines):
     return base + "\n" + "\n".join(lines)
 
 
+#: A list where a word belongs, in every section: (section, key = value, what the line names).
+LIST_WORDS = [("study", 'name = ["tiny"]', "name"), ("study", 'description = ["d"]', "description"),
+              ("study", 'sweep = ["up"]', "sweep"), ("study", 'initial = ["paper"]', "initial"),
+              ("study", 'method = ["rk4"]', "method"), ("excitation", 'kind = ["sine"]', "kind"),
+              ("fixed", 'cork = ["cubic"]', "cork"), ("axes", 'cork = [["cubic"]]', "cork")]
+
+
+@pytest.mark.parametrize("section, line, names", LIST_WORDS, ids=lambda c: str(c)[:14])
+def test_a_list_where_a_word_belongs_is_refused_in_one_line(section, line, names, tmp_path,
+                                                            capsys):
+    key = line.split(" = ")[0]
+    text = "\n".join(row for row in GOOD_STUDY.splitlines()
+                      if not (row.startswith(f"{key} = ") and section in ("study", "excitation")))
+    if f"[{section}]" in text:
+        text = text.replace(f"[{section}]", f"[{section}]\n{line}", 1)
+    else:
+        text += f"\n[{section}]\n{line}\n"
+    path = _study(tmp_path, text)
+    assert_refused(["sweep", str(path), "--dry-run"], capsys, names, "s.toml")
+
+
 @settings(max_examples=200, deadline=None, suppress_health_check=list(HealthCheck))
 @given(text=study_texts())
 def test_fuzzed_study_files_never_crash(text, tmp_path_factory, capsys):

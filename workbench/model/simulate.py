@@ -541,7 +541,7 @@ def check_method(method: str | None, tol: float | None, dt_given: bool = False,
     names = names or {}
     if method is None:
         method = "rk4" if dt_given and tol is None else DEFAULT_METHOD
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise ParameterError(f"{names.get('method', 'method')} = {method!r} is not a method; "
                              f"use one of {', '.join(sorted(METHODS))}")
     if not METHODS[method].controlled:

@@ -190,7 +190,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
 
     exc = dict(data.get("excitation", {"kind": "none"}))
     kind = exc.pop("kind", None)
-    if kind not in drives.DRIVES:
+    if not isinstance(kind, str) or kind not in drives.DRIVES:
         raise StudyError(f"[excitation] kind = {kind!r}; allowed: {sorted(drives.DRIVES)}")
     fixed = dict(data.get("fixed", {}))
     axes = dict(data.get("axes", {}))
