@@ -7,6 +7,7 @@ import pytest
 from workbench.core import layout as ly
 from workbench.model import excitation as X
 from workbench.model.limits import DEFAULT_TOL
+from workbench.model.methods import DEFAULT_LEVEL_MAX
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.simulate import default_dt, simulate
 
@@ -156,8 +157,8 @@ def test_intervals_below_the_floor_are_reported(rocking):
 
 
 #: The 0.508 mm chirp (studies/chirp.toml) at t = 27.29 s, regime 14, from its run:
-#: 2 ms later an accumulation of impacts floods one step of the finest lattice
-#: (1.56e-6 s) with more than 64 events.
+#: 2 ms later an accumulation of impacts floods a step of 1.56e-6 s (a 64th of the
+#: base step) with more than 64 events; steps of a 256th resolve it.
 FLOOD_STATE = (-1.874708104081763, -0.2633982953695513, 0.009218692853584344, 2.0251973709979736,
                0.025411751438348684, -0.012167639195205292, -1.572727023087652,
                -0.05412203690518417, 0.0017547322680382706, 1468.581110232601,
@@ -173,10 +174,14 @@ def test_an_event_flood_is_refined_to_the_floor_and_reported():
     floor interval)."""
     p = Parameters(cork="cubic", tip_mass=True).replace(gap_mm=0.508)
     run = simulate(p, X.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
-                   initial=np.array(FLOOD_STATE), regime=14, t0=27.29)
+                   initial=np.array(FLOOD_STATE), regime=14, t0=27.29, level_max=6)
     assert run.ok, run.message
     stepped = run.summary()["stepped_steps"]
     flooded = [f for f in run.control["floor_intervals"] if f["moreau_jean_steps"] > 0]
     assert stepped > 0 and sum(f["moreau_jean_steps"] for f in flooded) == stepped
     assert all(f["error_over_tol"] is None for f in flooded)
     assert run.control["h_min"] == pytest.approx(run.dt / 2 ** 6)
+    finer = simulate(p, X.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
+                     initial=np.array(FLOOD_STATE), regime=14, t0=27.29)
+    assert finer.ok and finer.summary()["stepped_steps"] == 0     # the default floor resolves it
+    assert finer.control["h_min"] >= run.dt / 2 ** DEFAULT_LEVEL_MAX
