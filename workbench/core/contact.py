@@ -122,7 +122,7 @@ def in_set(set_index, point):
 
 
 @nb.njit(**JIT_INLINE)
-def set_of(first, second):
+def set_of_pair(first, second):
     """Contact set index holding the points ``first`` and ``second`` (-1 for none).
 
     Returns -1 when the pair cannot touch together (1 with 2, 3 with 4).

@@ -33,7 +33,7 @@ from .config import (CLOSED_RATE, GAP_EPS, GAP_TOL, JIT, JIT_INLINE, LAMBDA_EPS,
 from . import layout as ly
 from .constrained import (add_contact_forces, fill_delassus, kinetic_energy, project, rhs_regime,
                           stick_margin, stick_tolerance, tangent_point, _put_row)
-from .contact import fill_geometry, in_set, row_convective, row_rate, set_of
+from .contact import fill_geometry, in_set, row_convective, row_rate, set_of_pair
 from .dynamics import rhs
 from .impact_law import NOT_FOUND, OPEN, SLIP_POS, STICK, solve_impact
 
@@ -46,7 +46,7 @@ def _compatible(pts, m, p):
         return True
     if m >= 2:
         return False
-    return set_of(int(pts[0]), p) > 0
+    return set_of_pair(int(pts[0]), p) > 0
 
 
 @nb.njit(**JIT)
@@ -153,7 +153,7 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
                 sign = 1.0 if modes[i] == SLIP_POS else -1.0
     set_index = 0
     if first >= 0:
-        set_index = first + 1 if second < 0 else set_of(first, second)
+        set_index = first + 1 if second < 0 else set_of_pair(first, second)
     rg[ly.RG_SET] = set_index
     rg[ly.RG_STICK] = 1.0 if (stick and set_index > 0) else 0.0
     rg[ly.RG_SIGN] = sign if sign != 0.0 else 1.0
@@ -299,7 +299,7 @@ def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
                         second = int(pts[i])
             set_index = 0
             if first >= 0:
-                set_index = first + 1 if second < 0 else set_of(first, second)
+                set_index = first + 1 if second < 0 else set_of_pair(first, second)
                 if set_index < 0:
                     continue
         if set_index == 0:

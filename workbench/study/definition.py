@@ -256,7 +256,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
             raise StudyError(f"{exc_}{at}") from None
         points.append(pt)
     if sweep != "independent":
-        points = _stepped(points, sweep)
+        points = _frequency_chains(points, sweep)
     else:
         points = [Point(p.values, p.params, p.excitation, chain=i) for i, p in enumerate(points)]
     raw = head.get("save_series", [])
@@ -303,7 +303,7 @@ def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     check_settings(point.params, ex, duration, dt, output_hz, names=where)
 
 
-def _stepped(points, sweep):
+def _frequency_chains(points, sweep):
     """Chains of equal non-frequency values, ordered by frequency (up, down or both)."""
     chains: dict[tuple, list[Point]] = {}
     for p in points:
