@@ -432,3 +432,16 @@ def test_a_run_left_running_by_a_dead_process_is_marked_interrupted(tmp_path):
         index = log_run(tmp_path, {"started": "now", "state": "running"})
     runs = read_runs(tmp_path)
     assert index == 2 and [r["state"] for r in runs] == ["interrupted", "done", "running"]
+
+
+def test_a_relative_results_folder_is_the_callers_whatever_the_workers_cwd(tmp_path, monkeypatch):
+    """joblib keeps its worker processes between sweeps, with the working directory they
+    started in: a relative --results must still mean the caller's folder."""
+    text = SMALL.replace("freq_hz = [20.0, 30.0]", "freq_hz = [20.0]").replace(
+        "save_series = [{gap_mm = 1.016, freq_hz = 20.0}]", "")
+    for folder in ("first", "second"):
+        (tmp_path / folder).mkdir()
+        monkeypatch.chdir(tmp_path / folder)
+        table = W.sweep(write(tmp_path, text), "res", jobs=2, progress=False)
+        assert table.status.tolist() == ["ok", "ok"]
+        assert len(list((tmp_path / folder / "res" / "small" / "points").glob("*.parquet"))) == 2

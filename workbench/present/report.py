@@ -127,7 +127,7 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
     The figures are drawn by ``jobs`` processes (joblib), a grid figure or
     one point's series per task.
     """
-    out = Path(results) / study.name
+    out = Path(results).resolve() / study.name      # absolute: worker processes keep their own cwd
     table = pd.read_parquet(out / "points.parquet")
     t0 = time.perf_counter()
     tags = series_tags(table)

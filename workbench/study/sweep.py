@@ -230,7 +230,7 @@ def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
     The study folder is locked while the sweep runs; the invocation is
     logged in runs.json (running, then done / interrupted / failed).
     """
-    out = Path(results) / study.name
+    out = Path(results).resolve() / study.name      # absolute: worker processes keep their own cwd
     out.mkdir(parents=True, exist_ok=True)
     with StudyLock(out):
         if fresh and (out / "points").exists():
