@@ -62,9 +62,7 @@ def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
     sig = pd.read_parquet(path)
     ev = pd.read_parquet(path.with_suffix(".events.parquet"))
     t_end = float(sig.index[-1])
-    title = point_title(row)
-    if row.direction:
-        title += f", {row.direction} sweep"
+    title = point_label(row)
     if row.status != "ok":                     # what was computed before the failure
         title += f" — {row.status} at t = {t_end:.2f} s"
     short = min(0.5, study.window_s)
@@ -86,24 +84,27 @@ def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
 _DRAW_COST = {"regime_shares": 4.0, "bifurcation": 3.0}
 
 
+def point_label(row) -> str:
+    """A point's title: its axis values, and a stepped sweep's direction."""
+    return point_title(row) + (f", {row.direction} sweep" if row.direction else "")
+
+
 def series_tags(table: pd.DataFrame) -> list[str]:
     """Each point's part of its figures' names: its axis values ("gap-1.016mm_tip-mass-on",
     :func:`~workbench.study.grid.point_slug`), a stepped sweep's direction, and the
     point's key where two points would share a name."""
-    tags = []
-    for _, row in table.iterrows():
-        tag = point_slug(row) or "point"
-        tags.append(f"{tag}_{row.direction}" if getattr(row, "direction", "") else tag)
+    tags = [f"{point_slug(row) or 'point'}_{row.direction}".rstrip("_")
+            for _, row in table.iterrows()]
     shared = {t for t in tags if tags.count(t) > 1}
     return [f"{t}_{key[:8]}" if t in shared else t for t, key in zip(tags, table.key)]
 
 
-def heading(name: str, table: pd.DataFrame, tags: list[str]) -> str:
-    """A figure's heading in the report: what it shows, and for which point."""
-    for tag, (_, row) in zip(tags, table.iterrows()):
+def heading(name: str, labels: dict[str, str]) -> str:
+    """A figure's heading in the report: what it shows, and for which point
+    (``labels``: each point's tag and :func:`point_label`)."""
+    for tag, label in labels.items():
         if name.endswith(f"_{tag}"):
-            title = point_title(row) + (f", {row.direction} sweep" if row.direction else "")
-            return f"{name[:-len(tag) - 1].replace('_', ' ')} — {title}"
+            return f"{name[:-len(tag) - 1].replace('_', ' ')} — {label}"
     return name.replace("_", " ")
 
 
@@ -223,8 +224,9 @@ def render_index(study, table, figures, tables, out) -> str:
     for p in tables:
         lines.append(f"- [{p.name}]({p.relative_to(out)})")
     lines += ["", "## Figures", ""]
+    labels = dict(zip(series_tags(table), (point_label(row) for _, row in table.iterrows())))
     for name, paths in figures.items():
         png, pdf = (p.relative_to(out) for p in paths)
-        lines += [f"### {heading(name, table, series_tags(table))}", "",
+        lines += [f"### {heading(name, labels)}", "",
                   f"![{name}]({png}) ([PDF]({pdf}))", ""]
     return "\n".join(lines) + "\n"

@@ -6,6 +6,8 @@ and each point in user units ("gap 1.016 mm, tip mass on").
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 
@@ -49,12 +51,6 @@ def point_title(row) -> str:
 def point_slug(row) -> str:
     """'gap-1.016mm_tip-mass-on' from a points-table row's axis values: a file name
     that says which point it is (:func:`point_title` in lower case, without spaces)."""
-    parts = []
-    for k, v in row.items():
-        if k.startswith("axis_"):
-            text = axis_text(k[5:], v)
-            for unit in (" mm", " hz", " n", " s"):
-                if text.lower().endswith(unit):
-                    text = text[:-len(unit)] + unit.strip()
-            parts.append(text.lower().replace(" ", "-").replace("/", "-"))
-    return "_".join(parts)
+    return "_".join(re.sub(r" (mm|hz|n|s)$", r"\1", axis_text(k[5:], v).lower())
+                    .replace(" ", "-").replace("/", "-")
+                    for k, v in row.items() if k.startswith("axis_"))

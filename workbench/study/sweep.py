@@ -38,7 +38,7 @@ from .provenance import code_version
 from ..model.methods import METHODS
 from ..model.simulate import default_dt, simulate
 from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
-from .definition import Point, Study
+from .definition import Point, Study, load
 
 #: A worker whose sweep process is gone stops within this many seconds.
 WATCHDOG_S = 1.0
@@ -217,7 +217,6 @@ def sweep(study: Study | str | Path, results: str | Path = "results", jobs: int 
     account; ``results/<name>/points.parquet``).
     """
     if not isinstance(study, Study):
-        from .definition import load
         study = load(study)
     return run_study(study, results, jobs=jobs, scheduler=scheduler, fresh=fresh,
                      progress=progress)
