@@ -27,7 +27,7 @@ import pandas as pd
 
 from lsoda_side_by_side import CompiledLSODA
 from workbench.core import layout as ly
-from workbench.model.excitation import DEFAULT_FORCE_N, chirp, sine
+from workbench.model.drives import DEFAULT_FORCE_N, chirp, sine
 from workbench.model.params import Parameters
 from workbench.model.regimes import is_stick, set_of
 from workbench.model.simulate import simulate

@@ -23,7 +23,7 @@ import sys
 import numpy as np
 from joblib import Parallel, delayed
 
-from workbench.model.excitation import chirp, sine
+from workbench.model.drives import chirp, sine
 from workbench.model.params import Parameters
 from workbench.model.simulate import default_dt, simulate
 from workbench.model.regimes import contact_shares_of

@@ -15,7 +15,7 @@ from __future__ import annotations
 import argparse
 import statistics
 
-from workbench.model.excitation import chirp, sine
+from workbench.model.drives import chirp, sine
 from workbench.model.params import Parameters
 from workbench.model.simulate import default_dt, simulate
 

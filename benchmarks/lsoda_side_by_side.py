@@ -33,7 +33,7 @@ from workbench.core.hybrid import _immediate_impact, _stepped, apply_event, even
 from workbench.core.sensors import fill_signals
 from workbench.core.transitions import choose_regime
 from workbench.model import packing as mdl
-from workbench.model.excitation import sine
+from workbench.model.drives import sine
 from workbench.model.params import Parameters
 from workbench.model.regimes import contact_code, is_stick, regime_of, set_of
 from workbench.model.simulate import default_dt, simulate, stepped_dt

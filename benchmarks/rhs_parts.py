@@ -22,7 +22,7 @@ from workbench.core.constrained import project, rhs_regime
 from workbench.core.dynamics import add_applied_forces, assemble_inertia, factor_free, rhs
 from workbench.core.hybrid import event_values
 from workbench.core.integrate import rk_step
-from workbench.model.excitation import sine
+from workbench.model.drives import sine
 from workbench.model.params import Parameters
 
 PARTS = ("mass matrix, h, gravity", "applied forces", "factor of M (LDL^T)", "rhs (free flight)",

@@ -15,7 +15,7 @@ import pytest
 
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
-from workbench.model.excitation import sine
+from workbench.model.drives import sine
 from workbench.model.freeflight import integrate
 from workbench.model.params import Parameters
 

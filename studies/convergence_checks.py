@@ -3,7 +3,7 @@ penetration and drift, and the 10 s benchmark run.  python studies/convergence_c
 import numpy as np
 from workbench.model.params import Parameters
 from workbench.model.simulate import simulate
-from workbench.model.excitation import sine, DEFAULT_FORCE_N
+from workbench.model.drives import sine, DEFAULT_FORCE_N
 p = Parameters()
 runs = {dt: simulate(p, None, 0.1, dt=dt, initial="paper") for dt in (5e-5, 2.5e-5, 1.25e-5, 6.25e-6, 5e-6)}
 print("events", {dt: len(r.events) for dt, r in runs.items()})

@@ -16,7 +16,7 @@ import argparse
 import json
 from pathlib import Path
 
-from workbench.model import excitation
+from workbench.model import drives as excitation
 from workbench.model.params import Parameters
 from workbench.model.simulate import simulate
 

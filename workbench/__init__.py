@@ -11,7 +11,7 @@ The API a user calls (docs/usage.md)::
 - the model: :class:`Parameters`, :func:`simulate` (a :class:`Run`),
   :func:`static_equilibrium`, :func:`natural_frequencies`, :func:`mode_shapes`;
 - the drives: :func:`sine`, :func:`chirp`, :func:`hammer_joint`,
-  :func:`hammer_tip` (module :mod:`excitation`);
+  :func:`hammer_tip` (module :mod:`drives`, the registry of drives);
 - studies: :func:`load_study`, :func:`sweep`;
 - lab files: :func:`read`, :func:`write`, :func:`convert`,
   :func:`record_from_run`, :func:`frf`, :func:`compare`.
@@ -33,10 +33,10 @@ _API = {
     "static_equilibrium": ("model.statics", "static_equilibrium"),
     "natural_frequencies": ("model.modes", "natural_frequencies"),
     "mode_shapes": ("model.modes", "mode_shapes"),
-    "excitation": ("model.excitation", None),
-    "sine": ("model.excitation", "sine"), "chirp": ("model.excitation", "chirp"),
-    "hammer_joint": ("model.excitation", "hammer_joint"),
-    "hammer_tip": ("model.excitation", "hammer_tip"),
+    "drives": ("model.drives", None),
+    "sine": ("model.drives", "sine"), "chirp": ("model.drives", "chirp"),
+    "hammer_joint": ("model.drives", "hammer_joint"),
+    "hammer_tip": ("model.drives", "hammer_tip"),
     "load_study": ("study.definition", "load"), "sweep": ("study.sweep", "sweep"),
     "read": ("experiments.files", "read"), "write": ("experiments.files", "write"),
     "convert": ("experiments.files", "convert"),

@@ -247,7 +247,7 @@ def _shortcut_drive(args) -> dict | None:
 
 def _run_drive(args) -> dict:
     """The complete drive settings of ``workbench run`` (amplitude and soft start filled)."""
-    from .model import drives, excitation as X
+    from .model import drives
     drive = _shortcut_drive(args) or {"kind": "none"}
     if args.drive is not None:
         for option, value in (("--force-n", args.force_n), ("--ramp-s", args.ramp_s)):
@@ -263,7 +263,7 @@ def _run_drive(args) -> dict:
         raise ParameterError("--force-n does not apply to --free-decay (a release without drive)")
     keys = drives.get(drive["kind"]).keys
     if "force_n" in keys:
-        default = X.DEFAULT_HAMMER_N if hammer else X.DEFAULT_FORCE_N
+        default = drives.DEFAULT_HAMMER_N if hammer else drives.DEFAULT_FORCE_N
         drive["force_n"] = default if args.force_n is None else args.force_n
     if "ramp_s" in keys:
         drive["ramp_s"] = (min(DEFAULT_RAMP_S, 0.5 * args.duration) if args.ramp_s is None

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from workbench.core import layout as ly
-from workbench.model import excitation as X
+from workbench.model import drives
 from workbench.model.limits import DEFAULT_TOL
 from workbench.model.methods import DEFAULT_LEVEL_MAX
 from workbench.model.params import ParameterError, Parameters
@@ -21,7 +21,7 @@ def held_except(*names):
 @pytest.fixture(scope="module")
 def rocking():
     """The default case's first 0.1 s, driven hard from the paper's start: impacts, stick-slip."""
-    return Parameters().replace(gap_mm=1.016), X.sine(200.0, 20.0, ramp_s=0.02)
+    return Parameters().replace(gap_mm=1.016), drives.sine(200.0, 20.0, ramp_s=0.02)
 
 
 def test_one_level_is_rk4_at_half_the_step_bit_for_bit(rocking):
@@ -132,7 +132,7 @@ def test_the_estimate_falls_at_the_methods_order():
     step-doubling estimate of the pair (dt, dt/2) over that of (dt/2, dt/4) is RK4's 2^4
     (measured 15.99, 15.99 and 16.00 from 1e-4 s down)."""
     p = Parameters()
-    ex = X.sine(100.0, 20.0)
+    ex = drives.sine(100.0, 20.0)
     est = [simulate(p, ex, 0.05, dt=dt, tol=1e-3, level_max=1, fixed=("s", "v", "psi"),
                     initial="paper", output_hz=10000).control["error_over_tol_max"]
            for dt in (1e-4, 5e-5, 2.5e-5)]
@@ -173,7 +173,7 @@ def test_an_event_flood_is_refined_to_the_floor_and_reported():
     estimate (before this rule, these 11 steps were accepted at a coarser level with no
     floor interval)."""
     p = Parameters(cork="cubic", tip_mass=True).replace(gap_mm=0.508)
-    run = simulate(p, X.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
+    run = simulate(p, drives.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
                    initial=np.array(FLOOD_STATE), regime=14, t0=27.29, level_max=6)
     assert run.ok, run.message
     stepped = run.summary()["stepped_steps"]
@@ -181,7 +181,7 @@ def test_an_event_flood_is_refined_to_the_floor_and_reported():
     assert stepped > 0 and sum(f["moreau_jean_steps"] for f in flooded) == stepped
     assert all(f["error_over_tol"] is None for f in flooded)
     assert run.control["h_min"] == pytest.approx(run.dt / 2 ** 6)
-    finer = simulate(p, X.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
+    finer = simulate(p, drives.chirp(200.0, 5.0, 65.0, 240.0, 1.0), 0.004, output_hz=500.0,
                      initial=np.array(FLOOD_STATE), regime=14, t0=27.29)
     assert finer.ok and finer.summary()["stepped_steps"] == 0     # the default floor resolves it
     assert finer.control["h_min"] >= run.dt / 2 ** DEFAULT_LEVEL_MAX

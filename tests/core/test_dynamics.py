@@ -13,7 +13,7 @@ from workbench.reference import Reference
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.dynamics import energies, eval_inertia, eval_rhs
-from workbench.model.excitation import sine
+from workbench.model.drives import sine
 from workbench.model.freeflight import integrate
 from workbench.model.params import ParameterError, Parameters
 

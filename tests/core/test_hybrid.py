@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings, strategies as st
 
-from workbench.model import excitation as X
+from workbench.model import drives
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import kinetic_energy, rhs_regime
@@ -110,7 +110,7 @@ def _impact_setup(p, point, q, qd):
     y = np.concatenate([q, qd, np.zeros(ly.N_AUG - ly.N_STATE)])
     work.rg[:] = 0.0
     yd = np.zeros(ly.N_AUG)
-    assert rhs_regime(0.0, y, *model[:4], X.none(), work.rec, work.mat, work.vec, work.cg, work.cw,
+    assert rhs_regime(0.0, y, *model[:4], drives.none(), work.rec, work.mat, work.vec, work.cg, work.cw,
                       work.rg, yd) == ly.OK
     return model, work, y
 
@@ -244,13 +244,13 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     (113 cm/s x 1e-11 s) of GAP_EPS.
     """
     p = Parameters(cork="quadratic").replace(gap_mm=1.016)
-    run = simulate(p, X.sine(200.0, 45.0, ramp_s=1.0), 2.2)
+    run = simulate(p, drives.sine(200.0, 45.0, ramp_s=1.0), 2.2)
     assert run.ok, run.message
     assert run.stats["max_penetration_cm"] < 3e-9
 
 
 def test_energy_balance_closes_at_a_fine_step():
-    run = simulate(Parameters(), X.sine(50.0, 20.0, ramp_s=0.05), 0.15, dt=5e-6,
+    run = simulate(Parameters(), drives.sine(50.0, 20.0, ramp_s=0.05), 0.15, dt=5e-6,
                    initial="paper")
     assert run.ok, run.message
     s = run.summary()
@@ -291,7 +291,7 @@ def test_every_regime_is_reached():
     p = Parameters()
     for tip in (True, False):
         reached |= set(simulate(Parameters(tip_mass=tip), None, 1.0, initial="paper").events.to_regime)
-    reached |= set(simulate(p.replace(gap_mm=1.016), X.sine(20.0, 45.0, ramp_s=1.0), 3.0)
+    reached |= set(simulate(p.replace(gap_mm=1.016), drives.sine(20.0, 45.0, ramp_s=1.0), 3.0)
                    .events.to_regime)
     q0 = np.zeros(18)
     q0[ly.S], q0[ly.V] = 1.0, -p.gap / 2
@@ -319,11 +319,11 @@ def test_every_regime_is_reached():
 
 def test_hammer_and_free_decay_runs():
     p = Parameters()
-    run = simulate(p, X.hammer_joint(200.0, 1e-3, 0.01), 0.1, output_hz=20000)
+    run = simulate(p, drives.hammer_joint(200.0, 1e-3, 0.01), 0.1, output_hz=20000)
     assert run.ok, run.message
     assert run.signals.hammer.abs().max() == pytest.approx(200.0e5, rel=1e-3)
     assert run.signals.w_excitation.iloc[-1] != 0.0
-    run = simulate(p, X.hammer_tip(-100.0, 1e-3, 0.01), 0.05)
+    run = simulate(p, drives.hammer_tip(-100.0, 1e-3, 0.01), 0.05)
     assert run.ok, run.message
     run = simulate(p, None, 0.05, free_decay_cm=2.0)
     assert run.ok, run.message
@@ -339,7 +339,7 @@ def test_bad_input_names_the_parameter():
     with pytest.raises(ParameterError, match="initial"):
         simulate(p, None, 0.1, initial="upside-down")
     with pytest.raises(ParameterError, match="free_decay_cm"):
-        simulate(p, X.sine(1.0, 20.0), 0.1, free_decay_cm=1.0)
+        simulate(p, drives.sine(1.0, 20.0), 0.1, free_decay_cm=1.0)
     with pytest.raises(ParameterError, match="t0"):
         simulate(p, None, 0.1, t0=-1.0)
     with pytest.raises(ParameterError, match="regime = 17 .* 0..16"):
@@ -365,12 +365,12 @@ def test_default_step_is_the_largest_stable_nice_step(tip, expected):
     for h in larger:                                # every larger candidate is unstable
         assert rk4_amplification(lam * h).max() > 1.0
     # a 1 ms hammer pulse gets 20 steps or more
-    assert default_dt(p, X.hammer_joint(100.0, 1e-3, 0.01)) == min(expected, 5e-5)
+    assert default_dt(p, drives.hammer_joint(100.0, 1e-3, 0.01)) == min(expected, 5e-5)
 
 
 def test_a_run_continued_from_its_state_follows_the_whole_run():
     p = Parameters().replace(gap_mm=1.016)
-    ex = X.sine(X.DEFAULT_FORCE_N, 20.0, ramp_s=0.2)
+    ex = drives.sine(drives.DEFAULT_FORCE_N, 20.0, ramp_s=0.2)
     whole = simulate(p, ex, 0.6, method="rk4")     # the same lattice of steps in both
     sig = whole.signals
     k = int(np.argmin(np.abs(sig.index.to_numpy() - 0.3)))

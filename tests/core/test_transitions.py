@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from workbench.model import excitation as X
+from workbench.model import drives
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import kinetic_energy, project
@@ -78,7 +78,7 @@ def test_moreau_jean_step_is_plastic_and_dissipative():
     work.rg[:] = 0.0
     st = np.zeros(ly.N_ST)
     h = 1e-4
-    status = moreau_jean_step(0.0, h, *model, X.none(), work.rec, work.mat, work.vec, work.stages,
+    status = moreau_jean_step(0.0, h, *model, drives.none(), work.rec, work.mat, work.vec, work.stages,
                               work.cg, work.cw, work.rg, st)
     assert status == ly.OK
     after = work.stages[ly.STAGE_CUR]
@@ -114,7 +114,7 @@ def test_moreau_jean_episode_keeps_the_axial_modes_bounded(tip_mass):
         work.rg[:] = 0.0
         st = np.zeros(ly.N_ST)
         for k in range(STEPPED_STEPS + 1):
-            assert _stepped(k * dt, dt, *model, X.none(), *work, st) == ly.OK
+            assert _stepped(k * dt, dt, *model, drives.none(), *work, st) == ly.OK
         return max(abs(y[ly.N_DOF + ly.U_A]), abs(y[ly.N_DOF + ly.U_B])), st[ly.ST_N_STEPPED]
 
     rate, n_steps = episode(stepped_dt(p))
@@ -126,7 +126,7 @@ def test_moreau_jean_episode_keeps_the_axial_modes_bounded(tip_mass):
 
 def hard_run(force_n, freq_hz, duration, **changes):
     p = Parameters(cork="cubic", tip_mass=True, **changes).replace(gap_mm=1.016)
-    return simulate(p, X.sine(force_n, freq_hz, ramp_s=1.0), duration)
+    return simulate(p, drives.sine(force_n, freq_hz, ramp_s=1.0), duration)
 
 
 @pytest.mark.parametrize("force_n, freq_hz", [(100.0, 45.0), (200.0, 50.0), (200.0, 30.0)])

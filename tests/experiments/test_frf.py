@@ -10,7 +10,7 @@ from scipy import signal
 
 from workbench import cli
 from workbench.experiments.frf import frf, peaks
-from workbench.model import excitation as X, packing as mdl
+from workbench.model import drives, packing as mdl
 from workbench.model.modes import natural_frequencies
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.simulate import simulate
@@ -68,7 +68,7 @@ def test_the_locked_joint_driven_by_a_chirp_has_its_modes_as_peaks():
     of one segment's resonance runs on into segments whose force has left that frequency,
     which a single sweep cannot avoid: there it is 0.8."""
     p = Parameters(tip_mass=True).replace(g=0.0)
-    run = simulate(p, X.chirp(2.0, 5.0, 60.0, 60.0), 60.0, fixed=mdl.JOINT, initial="paper",
+    run = simulate(p, drives.chirp(2.0, 5.0, 60.0, 60.0), 60.0, fixed=mdl.JOINT, initial="paper",
                    output_hz=500.0)
     assert run.ok, run.message
     table = frf(run.signals, ["accel3", "strain2"], segment_s=10.0)

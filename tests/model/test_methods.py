@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from workbench.core import layout as ly
-from workbench.model import excitation as X, methods
+from workbench.model import drives, methods
 from workbench.model.packing import build
 from workbench.model.params import Parameters
 from workbench.model.simulate import simulate
@@ -39,7 +39,7 @@ def registered(monkeypatch):
 
 
 def tip_after(method, dt, duration=0.02):
-    run = simulate(Parameters(), X.sine(100.0, 20.0), duration, dt=dt, method=method,
+    run = simulate(Parameters(), drives.sine(100.0, 20.0), duration, dt=dt, method=method,
                    fixed=JOINT_HELD, initial="paper", output_hz=1.0 / (4 * dt))
     assert run.status == ly.OK
     return run.states[-1, :ly.N_DOF]
@@ -61,7 +61,7 @@ def test_the_controller_takes_the_order_of_the_tableau(registered):
     """Step doubling over the same 0.1 ms control intervals: the estimate of the pair
     (dt, dt/2) over that of (dt/2, dt/4) is 2^3 for Kutta's third-order method, whose
     Richardson factor the controller takes from the tableau (2^3 - 1)."""
-    est = [simulate(Parameters(), X.sine(100.0, 20.0), 0.05, dt=dt, tol=1e-3, level_max=1,
+    est = [simulate(Parameters(), drives.sine(100.0, 20.0), 0.05, dt=dt, tol=1e-3, level_max=1,
                     method="kutta3_controlled", fixed=JOINT_HELD, initial="paper",
                     output_hz=10000).control["error_over_tol_max"]
            for dt in (1e-4, 5e-5)]

@@ -11,7 +11,7 @@ def test_defaults_are_the_model_md_values():
     # docs/model.md §2 (Tables 3, 4, Appendix B) and §6 (Table 6)
     assert (p.rho, p.mu_a, p.rho_i_a, p.m3, p.i3, p.m4, p.i4, p.m6, p.i6) == (
         2.5065, 4.0428, 0.03396, 313.81, 6973.4, 123.33, 1398.6, 158.9, 301.55)
-    assert p.cork_law == (3.0, 1.0e4, 1.7e4)
+    assert p.cork_law == (3.0, 1.0e4, 1.7e4, "power")
     assert Parameters(cork="static").cork_law[1] == pytest.approx((4.19e7 + 2.23e7 + 7.13e7) / 3, rel=1e-3)
 
 
@@ -89,7 +89,7 @@ def test_type_errors():
 def test_e_in_gpa_and_overrides():
     p = Parameters().replace(e_a_gpa=50.48, cork="linear", cork_k=4.83e5)
     assert p.e_a == pytest.approx(5.048e11)
-    assert p.cork_law == (1.0, 4.83e5, 1.7e4)
+    assert p.cork_law == (1.0, 4.83e5, 1.7e4, "power")
 
 
 def test_toml_round_trip_and_errors(tmp_path):

@@ -11,10 +11,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.core import layout as ly
+from workbench.core import excitation as cx, layout as ly
 from workbench.core.contact import regime_of as kernel_regime_of
 from workbench.experiments.matching import setup_from
-from workbench.model import drives, excitation as X, regimes
+from workbench.model import drives, regimes
 from workbench.model.params import ParameterError
 from workbench.reference.events import Regime
 from workbench.study import definition as S
@@ -26,7 +26,7 @@ def sine_rms(monkeypatch):
     monkeypatch.setattr(drives, "DRIVES", dict(drives.DRIVES))
     return drives.register(drives.Drive(
         "sine_rms", ("force_n", "freq_hz", "ramp_s"),
-        lambda e: X.sine(e["force_n"] * np.sqrt(2.0), e["freq_hz"], e["ramp_s"]),
+        lambda e: drives.sine(e["force_n"] * np.sqrt(2.0), e["freq_hz"], e["ramp_s"]),
         ramped=True, frequency_key="freq_hz"))
 
 
@@ -52,7 +52,7 @@ def test_a_registered_drive_is_a_study_excitation_and_a_record_drive(sine_rms, t
     points = study.points
     assert [p.drive_hz for p in points] == [20.0, 30.0]
     ex = points[0].excitation_array()
-    assert ex[ly.X_AMP] == pytest.approx(10.0 * np.sqrt(2.0) * X.DYN_PER_N)
+    assert ex[cx.X_AMP] == pytest.approx(10.0 * np.sqrt(2.0) * drives.DYN_PER_N)
     assert points[0].start_keywords == {}
     # a record that says WB_drive = sine_rms is matched by the same drive
     record = pd.DataFrame({"force1": np.zeros(101)}, index=pd.Index(np.arange(101) * 1e-3, name="t"))
@@ -67,13 +67,13 @@ def test_an_unknown_drive_names_the_kinds():
     with pytest.raises(ParameterError, match="allowed: chirp, free_decay, hammer_joint"):
         drives.get("square")
     with pytest.raises(ValueError, match="without a unit"):
-        drives.register(drives.Drive("bad", ("volts",), lambda e: X.none()))
+        drives.register(drives.Drive("bad", ("volts",), lambda e: drives.none()))
 
 
 def test_a_free_decay_is_a_start_not_a_force():
     settings = {"kind": "free_decay", "deflection_cm": 2.0}
     assert drives.start_keywords(settings) == {"free_decay_cm": 2.0}
-    assert int(drives.excitation_array(settings)[ly.X_KIND]) == ly.EXC_NONE
+    assert int(drives.excitation_array(settings)[cx.X_KIND]) == cx.EXC_NONE
     assert drives.drive_hz(settings) is None
 
 
@@ -96,11 +96,11 @@ def test_the_regime_vocabulary_agrees_with_the_kernels_and_the_reference():
 def test_a_cork_law_is_one_entry_of_the_table(monkeypatch):
     from workbench.cli import build_parser
     from workbench.model.modes import natural_frequencies
-    from workbench.model.params import CORK_MODELS, Parameters
+    from workbench.model.params import CORK_MODELS, CorkLaw, Parameters
 
-    monkeypatch.setitem(CORK_MODELS, "soft", (1.0, 1.0e5, 1.0e4))
+    monkeypatch.setitem(CORK_MODELS, "soft", CorkLaw(1.0, 1.0e5, 1.0e4))
     p = Parameters(cork="soft")
-    assert p.cork_law == (1.0, 1.0e5, 1.0e4)
+    assert p.cork_law == (1.0, 1.0e5, 1.0e4, "power")
     stiff = natural_frequencies(Parameters(cork="linear"), "free")
     soft = natural_frequencies(p, "free")
     assert soft[soft > 0].min() < stiff[stiff > 0].min()       # a softer spring on s

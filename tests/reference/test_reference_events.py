@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from workbench.core.excitation import shaker_force
-from workbench.model.excitation import chirp, sine
+from workbench.model.drives import chirp, sine
 from workbench.reference import HybridReference, shaker
 from workbench.core import layout as ly
 from workbench.model.params import Parameters

@@ -18,7 +18,8 @@ import numba as nb
 
 from .config import CHOLESKY_REL_PIVOT, JIT, JIT_INLINE
 from . import layout as ly
-from .excitation import hammer_force, shaker_force
+from .cork import cork_potential, cork_spring
+from .excitation import EXC_HAMMER_JOINT, X_KIND, hammer_force, shaker_force
 from .inertia import frame_sums
 from .kinematics import beam_b_point, compute_frames, rigid_point, tip_row
 
@@ -56,20 +57,6 @@ def fill_stiffness_damping(P, kc):
 
 
 @nb.njit(**JIT_INLINE)
-def cork_spring(s, n, k):
-    """The cork's spring force k sign(s)|s|^n (dyn), docs/model.md §6; products for the
-    paper's n = 1, 2, 3 (a power costs ~20x)."""
-    a = abs(s)
-    if n == 1.0:
-        return k * s
-    if n == 2.0:
-        return k * s * a
-    if n == 3.0:
-        return k * s * a * a
-    return k * math.copysign(a ** n, s)
-
-
-@nb.njit(**JIT_INLINE)
 def slot_overtravel(s, P):
     """How far the slide s is past the slot's end stop (cm): |s| - s_travel, or 0."""
     return max(abs(s) - P[ly.P_S_TRAVEL], 0.0)
@@ -79,19 +66,20 @@ def slot_overtravel(s, P):
 def cork_force(s, sd, P):
     """Cork force on the slide s (dyn), docs/model.md §6.
 
-    k sign(s)|s|^n + c s', plus the slot's end stop k_stop (|s| - s_travel)
-    sign(s) beyond |s| > s_travel.
+    The law's spring (:mod:`workbench.core.cork`) + c s', plus the slot's end
+    stop k_stop (|s| - s_travel) sign(s) beyond |s| > s_travel.
     """
     stop = P[ly.P_K_STOP] * math.copysign(slot_overtravel(s, P), s)
-    return cork_spring(s, P[ly.P_CORK_N], P[ly.P_CORK_K]) + stop + P[ly.P_CORK_C] * sd
+    spring = cork_spring(s, P[ly.P_CORK_FORM], P[ly.P_CORK_N], P[ly.P_CORK_K])
+    return spring + stop + P[ly.P_CORK_C] * sd
 
 
 @nb.njit(**JIT_INLINE)
 def cork_energy(s, P):
-    """Cork potential k |s|^(n+1) / (n+1) + k_stop (|s| - s_travel)_+^2 / 2 (erg), docs/model.md §6."""
-    n = P[ly.P_CORK_N]
+    """Cork potential V(s) + k_stop (|s| - s_travel)_+^2 / 2 (erg), docs/model.md §6."""
     over = slot_overtravel(s, P)
-    return P[ly.P_CORK_K] * abs(s) ** (n + 1.0) / (n + 1.0) + 0.5 * P[ly.P_K_STOP] * over * over
+    spring = cork_potential(s, P[ly.P_CORK_FORM], P[ly.P_CORK_N], P[ly.P_CORK_K])
+    return spring + 0.5 * P[ly.P_K_STOP] * over * over
 
 
 @nb.njit(**JIT)
@@ -162,7 +150,7 @@ def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
     aux[ly.AUX_F_HAMMER] = Fh
     if Fh != 0.0:
         pt = rec[ly.REC_POINT]
-        if int(ex[ly.X_KIND]) == ly.EXC_HAMMER_JOINT:   # vertical, joint body base
+        if int(ex[X_KIND]) == EXC_HAMMER_JOINT:   # vertical, joint body base
             rigid_point(rec, ly.REC_JOINT, 0.0, 0.0, ly.REC_POINT)
             ex_, ey_ = 0.0, 1.0
         else:                                           # along beam B's axis at its tip

@@ -9,13 +9,13 @@ import numba as nb
 import numpy as np
 
 from .config import JIT, JIT_INLINE, JIT_PARALLEL
-from .dynamics import cork_spring
+from .cork import power_spring
 from .layout import ERR_NAN, OK
 
 
 @nb.njit(**JIT_INLINE)
 def _accel(s, v, inv_m, n_exp, k, c):
-    return -(cork_spring(s, n_exp, k) + c * v) * inv_m
+    return -(power_spring(s, n_exp, k) + c * v) * inv_m
 
 
 @nb.njit(**JIT_INLINE)

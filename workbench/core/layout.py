@@ -50,8 +50,8 @@ P_I6 = 24        # tip mass inertia about its CM (g cm^2), likewise
 P_MU_S = 25      # static friction coefficient (-)
 P_MU_K = 26      # kinetic friction coefficient (-)
 P_GRAV = 27      # gravitational acceleration (cm/s^2)
-P_CORK_N = 28    # cork spring exponent n (-)
-P_CORK_K = 29    # cork stiffness k (g/(s^2 cm^(n-1)))
+P_CORK_N = 28    # cork law's shape parameter n (the power law's exponent, -)
+P_CORK_K = 29    # cork law's stiffness k (the power law's g/(s^2 cm^(n-1)))
 P_CORK_C = 30    # cork damping c (g/s)
 P_K_V = 31       # optional spring on v (g/s^2); 0 in the paper's model
 P_K_PSI = 32     # optional spring on psi (g cm^2/s^2); 0 in the paper's model
@@ -65,13 +65,14 @@ P_C_AX_B = 39    # beam B axial damping on u_B (g/s)
 P_S_TRAVEL = 40  # slide before the slot's end stop, each way (cm; inf for none)
 P_K_STOP = 41    # end-stop stiffness beyond |s| > s_travel (g/s^2)
 P_STEPPED_DT = 42  # largest Moreau-Jean step (s); inf until simulate sets it from the model's modes
+P_CORK_FORM = 43   # cork law's form: its index in workbench.core.cork.FORMS (stored as a float)
 # The step method: the explicit Runge-Kutta tableau (Butcher's c, A, b) that
 # every integrator steps with (workbench.core.integrate.rk_step); written by
 # workbench.model.tableaus.write_tableau (classical RK4 by default).
 MAX_RK_STAGES = 6
-P_RK_STAGES = 43   # number of stages s (stored as a float)
-P_RK_ORDER = 44    # order p: global error O(dt^p) (the controller's Richardson factor 2^p - 1)
-P_RK_C = 45        # P_RK_C + i: node c_i (-), i < MAX_RK_STAGES
+P_RK_STAGES = 44   # number of stages s (stored as a float)
+P_RK_ORDER = 45    # order p: global error O(dt^p) (the controller's Richardson factor 2^p - 1)
+P_RK_C = 46        # P_RK_C + i: node c_i (-), i < MAX_RK_STAGES
 P_RK_B = P_RK_C + MAX_RK_STAGES   # P_RK_B + i: weight b_i (-)
 P_RK_A = P_RK_B + MAX_RK_STAGES   # P_RK_A + MAX_RK_STAGES i + j: coefficient a_ij (-), j < i
 N_PARAMS = P_RK_A + MAX_RK_STAGES * MAX_RK_STAGES
@@ -93,24 +94,6 @@ T_S01 = 9     # Sigma_01 (-)
 T_S11 = 10    # Sigma_11 (cm)
 T_WEIGHT = 11 # quadrature weight w_i L / 2 (cm); 0 for sensor rows
 N_TAB = 12
-
-# --- excitation array EX -----------------------------------------------------
-X_KIND = 0       # one of EXC_* below
-X_AMP = 1        # force amplitude F0 (dyn)
-X_FREQ = 2       # sine frequency (Hz)
-X_F0 = 3         # chirp start frequency (Hz)
-X_F1 = 4         # chirp end frequency (Hz)
-X_T_SWEEP = 5    # chirp duration (s)
-X_RAMP = 6       # soft-start ramp duration (s); 0 for none
-X_T_HIT = 7      # hammer: start of the half-sine pulse (s)
-X_WIDTH = 8      # hammer: pulse duration (s)
-N_EXC = 9
-
-EXC_NONE = 0
-EXC_SINE = 1          # shaker at force1
-EXC_CHIRP = 2         # shaker at force1
-EXC_HAMMER_JOINT = 3  # vertical half-sine pulse at the joint body's base (docs/model.md §8)
-EXC_HAMMER_TIP = 4    # half-sine pulse along beam B's axis at its tip (§4.3)
 
 # --- status codes ------------------------------------------------------------
 OK = 0

@@ -38,8 +38,8 @@ from ..core import layout as ly
 from ..core.hammer import hammer_response, hammer_scores
 from ..model.params import CORK_MODELS, ParameterError, Parameters, check_positive
 
-#: Spring exponent of each law the paper fitted (Table 6).
-CORK_LAWS = {"linear": 1.0, "quadratic": 2.0, "cubic": 3.0}
+#: Spring exponent of each law the paper fitted (Table 6), from the model's table.
+CORK_LAWS = {law: CORK_MODELS[law].n for law in ("linear", "quadratic", "cubic")}
 #: The searched parameters, in the order of the score array's axes.
 NAMES = ("v0", "k", "c")
 #: Values per parameter of the profile behind the intervals, over the searched range.
@@ -128,8 +128,8 @@ def _uniform_dt(t: np.ndarray) -> float:
 def default_grid(law: str, n: int = 21) -> dict[str, np.ndarray]:
     """The search ranges: a decade and a half about Table 6's values (log spacing
     for k and c), v0 in 1-100 cm/s."""
-    k_paper = {"linear": 2.7e5, "quadratic": 6.0e4, "cubic": 1.0e4}[law]
-    c_paper = CORK_MODELS["linear"][2]
+    k_paper = CORK_MODELS[law].k
+    c_paper = CORK_MODELS[law].c
     return {"v0": np.geomspace(1.0, 100.0, n), "k": np.geomspace(k_paper / 30, k_paper * 30, n),
             "c": np.geomspace(c_paper / 30, c_paper * 30, n)}
 

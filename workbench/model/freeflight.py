@@ -14,7 +14,7 @@ import numpy as np
 from . import packing as mdl
 from ..core import layout as ly
 from ..core.integrate import integrate_fixed
-from .excitation import none
+from .drives import none
 from .params import ParameterError
 
 

@@ -26,8 +26,9 @@ MAX_FORCE_N = 1e4
 FREE_DECAY_MAX_CM = 20.0
 #: Steps per period of the highest drive frequency at least (sine, chirp ends).
 STEPS_PER_PERIOD = 20
-#: Steps per hammer pulse at least when the step is given.
+#: Steps per hammer pulse at least when the step is given, and in the default step.
 MIN_PULSE_STEPS = 5
+PULSE_STEPS = 20
 #: The longest study name (it names a folder).
 MAX_NAME_CHARS = 100
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from . import packing as mdl
 from ..core import layout as ly
+from ..core.cork import FORMS as CORK_FORMS, cork_stiffness
 from ..core.dynamics import eval_inertia
 from .params import ParameterError, Parameters
 
@@ -33,9 +34,8 @@ def linear_matrices(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, n
     eval_inertia(zero, zero, *model, *work)
     M = work.mat[ly.MAT_M].copy()
     K = model.kc[ly.KC_K].copy()
-    n, k, _ = p.cork_law
-    if n == 1.0:
-        K[ly.S, ly.S] += k
+    law = p.cork_law
+    K[ly.S, ly.S] += cork_stiffness(0.0, CORK_FORMS.index(law.form), law.n, law.k)
     f = model.free
     return M[np.ix_(f, f)], K[np.ix_(f, f)], [ly.COORD_NAMES[i] for i in f]
 
@@ -98,7 +98,7 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
         model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
         C = model.kc[ly.KC_C][np.ix_(model.free, model.free)].copy()
         if ly.S in model.free:
-            C[names.index("s"), names.index("s")] += p.cork_law[2]
+            C[names.index("s"), names.index("s")] += p.cork_law.c
         n = len(names)
         _check_conditioned(M, K, joint)
         Minv = np.linalg.inv(M)

@@ -23,6 +23,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from ..core import layout as ly
+from ..core.cork import FORMS as CORK_FORMS
 from ..core.dynamics import fill_stiffness_damping
 from ..core.shapes import fill_shape_row
 from .params import ParameterError, Parameters
@@ -75,7 +76,12 @@ def pack(p: Parameters) -> np.ndarray:
     P[ly.P_M6], P[ly.P_I6] = on * p.m6, on * p.i6
     P[ly.P_MU_S], P[ly.P_MU_K] = p.mu_s, p.mu_k
     P[ly.P_GRAV] = p.g
-    P[ly.P_CORK_N], P[ly.P_CORK_K], P[ly.P_CORK_C] = p.cork_law
+    law = p.cork_law
+    if law.form not in CORK_FORMS:
+        raise ParameterError(f"cork = {p.cork!r} has the form {law.form!r}, which the kernels do "
+                             f"not have; forms: {', '.join(CORK_FORMS)}")
+    P[ly.P_CORK_FORM] = CORK_FORMS.index(law.form)
+    P[ly.P_CORK_N], P[ly.P_CORK_K], P[ly.P_CORK_C] = law.n, law.k, law.c
     P[ly.P_K_V], P[ly.P_K_PSI] = p.k_v, p.k_psi
     P[ly.P_X_FORCE] = p.x_force
     P[ly.P_C_STRAIN] = p.c_strain

@@ -23,16 +23,29 @@ import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
-#: Cork models of docs/model.md §6 (seed §4.3, Tables 5-6): (n, k, c), with k in
-#: g/(s^2 cm^(n-1)) and c in g/s.  c = 1.7e4 g/s is the paper's average.
-CORK_MODELS: dict[str, tuple[float, float, float]] = {
-    "none": (1.0, 0.0, 0.0),
-    "linear": (1.0, 2.70e5, 1.7e4),      # Table 6, DE-1/DE-2
-    "quadratic": (2.0, 6.0e4, 1.7e4),    # Table 6, DE-K~x^2
-    "cubic": (3.0, 1.0e4, 1.7e4),        # Table 6, DE-K~x^3: the paper's choice
-    "static": (1.0, 4.52e7, 1.7e4),      # mean of Table 5's static compression
+class CorkLaw(NamedTuple):
+    """A cork law (docs/model.md §6): the spring's form (a name of
+    :data:`workbench.core.cork.FORMS`) with its shape parameter n and stiffness
+    k, and the damper c (g/s).  The power form is k sign(s)|s|^n, k in
+    g/(s^2 cm^(n-1))."""
+
+    n: float
+    k: float
+    c: float
+    form: str = "power"
+
+
+#: Cork models of docs/model.md §6 (seed §4.3, Tables 5-6).  c = 1.7e4 g/s is
+#: the paper's average.  A law of a new form is an entry here and its form in
+#: workbench/core/cork.py.
+CORK_MODELS: dict[str, CorkLaw] = {
+    "none": CorkLaw(1.0, 0.0, 0.0),
+    "linear": CorkLaw(1.0, 2.70e5, 1.7e4),      # Table 6, DE-1/DE-2
+    "quadratic": CorkLaw(2.0, 6.0e4, 1.7e4),    # Table 6, DE-K~x^2
+    "cubic": CorkLaw(3.0, 1.0e4, 1.7e4),        # Table 6, DE-K~x^3: the paper's choice
+    "static": CorkLaw(1.0, 4.52e7, 1.7e4),      # mean of Table 5's static compression
 }
 
 #: The paper's gaps (mm), seed §5.1.
@@ -116,7 +129,7 @@ class Parameters:
     cork: str = _p("cubic", "-", "§4.3: the cubic model gave the best agreement",
                    doc="cork model: " + ", ".join(CORK_MODELS))
     cork_n: float | None = _p(None, "-", "from the cork model", 1.0, 5.0, lo_open=False,
-                              doc="override of the cork spring exponent")
+                              doc="override of the cork law's shape parameter (the power law's exponent)")
     cork_k: float | None = _p(None, "g/(s^2 cm^(n-1))", "from the cork model", 0.0,
                               lo_open=False, doc="override of the cork stiffness")
     cork_c: float | None = _p(None, "g/s", "from the cork model", 0.0, lo_open=False,
@@ -180,12 +193,12 @@ class Parameters:
         return self.l4 / 2.0 if self.c4 is None else self.c4
 
     @property
-    def cork_law(self) -> tuple[float, float, float]:
-        """(n, k, c) of the cork, the model's values with any override."""
-        n, k, c = CORK_MODELS[self.cork]
-        return (n if self.cork_n is None else self.cork_n,
-                k if self.cork_k is None else self.cork_k,
-                c if self.cork_c is None else self.cork_c)
+    def cork_law(self) -> CorkLaw:
+        """The cork's law: the model's values with any override of n, k and c."""
+        n, k, c, form = CorkLaw(*CORK_MODELS[self.cork])
+        return CorkLaw(n if self.cork_n is None else self.cork_n,
+                       k if self.cork_k is None else self.cork_k,
+                       c if self.cork_c is None else self.cork_c, form)
 
     def first_frequency(self, beam: str) -> float:
         """A beam's own first clamped-free frequency (rad/s): 3.516/L^2 sqrt(EI/mu)."""

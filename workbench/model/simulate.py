@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import packing as mdl
-from ..core import layout as ly
-from .excitation import none
+from ..core import excitation as cx, layout as ly
+from . import drives
+from .drives import none
 from .tableaus import write_tableau
 from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
-from .limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, MIN_PULSE_STEPS, STABILITY_MARGIN,
-                     STEPS_PER_PERIOD, TOL_RANGE)
+from .limits import DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, STABILITY_MARGIN, TOL_RANGE
 from .params import ParameterError, Parameters, check_positive
 from .regimes import contact_code, contact_shares_of, in_contact, is_stick, set_of
 from .statics import static_equilibrium, tip_load_for_deflection
@@ -43,8 +43,6 @@ NICE_STEPS = tuple(1e-3 / n for n in range(10, 201))
 #: height is within 2.6e-5 of its range and the contact time shares within
 #: 5e-6 of a converged run (docs/performance.md).
 MAX_DEFAULT_DT = 1e-4
-#: Steps per hammer pulse at least (the pulse's half-sine and its ends).
-PULSE_STEPS = 20
 
 
 def rk4_amplification(z: np.ndarray) -> np.ndarray:
@@ -60,14 +58,13 @@ def default_dt(p: Parameters, excitation: np.ndarray | None = None) -> float:
     of :func:`workbench.model.modes.linear_eigenvalues`.  With the tip mass this
     is 1e-4 s (MAX_DEFAULT_DT; the fastest mode is -246 +- 2.05e4 j 1/s); without
     it 6.25e-5 s (1 ms / 16; -321 +- 3.54e4 j 1/s): the beams' lightly damped axial
-    modes, near the imaginary axis where RK4 is stable to |lambda dt| = 2.83.  A
-    hammer pulse gets at least PULSE_STEPS steps.
+    modes, near the imaginary axis where RK4 is stable to |lambda dt| = 2.83.  The
+    drive may bound it (a hammer pulse gets at least PULSE_STEPS steps).
     """
     lam = STABILITY_MARGIN * _eigenvalues(p)
     limit = MAX_DEFAULT_DT
-    if excitation is not None and int(excitation[ly.X_KIND]) in (ly.EXC_HAMMER_JOINT,
-                                                                 ly.EXC_HAMMER_TIP):
-        limit = min(limit, excitation[ly.X_WIDTH] / PULSE_STEPS)
+    if excitation is not None:
+        limit = min(limit, drives.of_array(excitation).dt_max(excitation))
     for dt in NICE_STEPS:
         if dt <= limit * (1.0 + 1e-12) and np.all(rk4_amplification(lam * dt) <= 1.0):
             return dt
@@ -112,16 +109,17 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
                    strict: bool = True) -> tuple[float, int, int]:
     """Check a run's settings against what its step can resolve; return (dt, decim, n_steps).
 
-    The step (given or :func:`default_dt`) must resolve the drive
-    (STEPS_PER_PERIOD steps per period of a sine or a chirp's highest
-    frequency, MIN_PULSE_STEPS per hammer pulse) and divide the output
-    interval and the duration.  ``strict`` (the command line and studies)
-    adds: the step RK4-stable for the model (:func:`stability_limit`), a
-    hammer hit and a soft-start ramp ending within the run.  The Python API
-    (:func:`simulate`) is not strict: a short look at a run's start, or a
-    deliberately unstable step in a test, stays possible.  ``names`` maps the setting names (duration, dt,
-    output_hz, freq_hz, f0_hz, f1_hz, width_s, t_hit_s, ramp_s) to the
-    names the user wrote (an option, a study key), for the messages.
+    The step (given or :func:`default_dt`) must resolve the drive (its
+    :class:`~workbench.model.drives.Drive`'s check: STEPS_PER_PERIOD steps per
+    period of a sine or a chirp's highest frequency, MIN_PULSE_STEPS per hammer
+    pulse) and divide the output interval and the duration.  ``strict`` (the
+    command line and studies) adds: the step RK4-stable for the model
+    (:func:`stability_limit`), a hammer hit and a soft-start ramp ending within
+    the run.  The Python API (:func:`simulate`) is not strict: a short look at a
+    run's start, or a deliberately unstable step in a test, stays possible.
+    ``names`` maps the setting names (duration, dt, output_hz, and the drive's
+    settings) to the names the user wrote (an option, a study key), for the
+    messages.
     Raises ParameterError.
     """
     names = names or {}
@@ -158,31 +156,7 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
     if abs(n_steps * dt - duration) > 1e-9 * duration:
         raise ParameterError(f"{name('duration')} = {duration:g} s is not a whole number of "
                              f"steps dt = {dt:g} s")
-    kind = int(ex[ly.X_KIND])
-    f_max = 1.0 / (STEPS_PER_PERIOD * dt)
-    end = t0 + duration
-    if kind == ly.EXC_SINE and ex[ly.X_FREQ] > f_max:
-        raise ParameterError(f"{name('freq_hz')} = {ex[ly.X_FREQ]:g} Hz is above what the step "
-                             f"dt = {dt:g} s resolves ({STEPS_PER_PERIOD} steps per period: at "
-                             f"most {f_max:g} Hz)")
-    if kind == ly.EXC_CHIRP:
-        for key, col in (("f0_hz", ly.X_F0), ("f1_hz", ly.X_F1)):
-            if ex[col] > f_max:
-                raise ParameterError(
-                    f"{name(key)} = {ex[col]:g} Hz is above what the step dt = {dt:g} s resolves "
-                    f"({STEPS_PER_PERIOD} steps per period: at most {f_max:g} Hz)")
-    if strict and kind in (ly.EXC_SINE, ly.EXC_CHIRP) and ex[ly.X_RAMP] > end:
-        raise ParameterError(f"{name('ramp_s')} = {ex[ly.X_RAMP]:g} s: the soft start would "
-                             f"end after the run ({end:g} s)")
-    if kind in (ly.EXC_HAMMER_JOINT, ly.EXC_HAMMER_TIP):
-        width = ex[ly.X_WIDTH]
-        if width < MIN_PULSE_STEPS * dt * (1.0 - 1e-9):
-            raise ParameterError(f"{name('width_s')} = {width:g} s is shorter than "
-                                 f"{MIN_PULSE_STEPS} steps dt = {dt:g} s: the step cannot "
-                                 "resolve the pulse (give a smaller dt or leave it out)")
-        if strict and ex[ly.X_T_HIT] + width > end:
-            raise ParameterError(f"{name('t_hit_s')} = {ex[ly.X_T_HIT]:g} s: the pulse of "
-                                 f"{width:g} s would end after the run ({end:g} s)")
+    drives.of_array(ex).check(ex, drives.Step(dt, t0 + duration, strict, name))
     return dt, decim, n_steps
 
 
@@ -426,7 +400,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
              tol: float | None = None, level_max: int = DEFAULT_LEVEL_MAX) -> Run:
     """Simulate ``duration`` seconds of the loose-joint beam (docs/model.md §3-9).
 
-    ``excitation`` is an array from :mod:`workbench.model.excitation` (default: none).
+    ``excitation`` is an array from :mod:`workbench.model.drives` (default: none).
     ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
     excitation is evaluated at those times (e.g. to continue from a state
     of an earlier run, given as ``initial`` with its ``regime``).
@@ -445,12 +419,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         raise ParameterError(f"params must be workbench.model.params.Parameters, got {type(params).__name__}")
     ex = none() if excitation is None else np.asarray(excitation, dtype=float)
     dt_given = dt is not None
-    if ex.shape != (ly.N_EXC,):
-        raise ParameterError("excitation must come from workbench.model.excitation (an array of "
-                             f"{ly.N_EXC} values)")
+    if ex.shape != (cx.N_EXC,):
+        raise ParameterError("excitation must come from workbench.model.drives (an array of "
+                             f"{cx.N_EXC} values)")
     dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, strict=False)
     method, tol = check_method(method, tol, dt_given=dt_given)
-    if free_decay_cm is not None and int(ex[ly.X_KIND]) != ly.EXC_NONE:
+    if free_decay_cm is not None and int(ex[cx.X_KIND]) != cx.EXC_NONE:
         raise ParameterError("free_decay_cm releases the structure without excitation; "
                              "leave excitation unset")
     model = mdl.build(params, fixed)
@@ -606,7 +580,7 @@ def compile_kernel(kernel, args) -> float:
     of ``workbench/core``), says so on stderr first, with the usual time.
     """
     import numba
-    if kernel.signatures:
+    if not hasattr(kernel, "signatures") or kernel.signatures:   # NUMBA_DISABLE_JIT: plain Python
         return 0.0
     from ..core._cache import CACHE_DIR
     module = kernel.py_func.__module__.rsplit(".", 1)[-1]

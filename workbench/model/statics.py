@@ -33,7 +33,7 @@ import numpy as np
 from . import packing as mdl
 from ..core import layout as ly
 from ..core.equilibrium import newton_set, static_state
-from .excitation import DYN_PER_N, none
+from .drives import DYN_PER_N, none
 from .params import ParameterError, Parameters
 from .regimes import CONTACT_CODES, SETS
 

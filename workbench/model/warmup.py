@@ -17,7 +17,7 @@ import time
 #: name -> Python code exercising the entry points of that group.
 GROUPS = {
     "event loop (run_controlled, run_hybrid)": """
-        from workbench.model.excitation import sine
+        from workbench.model.drives import sine
         from workbench.model.params import Parameters
         from workbench.model.simulate import simulate
         for method in ("controlled", "rk4"):

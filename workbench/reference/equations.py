@@ -131,6 +131,9 @@ class Reference:
 
     def __init__(self, p, free=range(N), excitation=None, n_gauss=6):
         self.p = p
+        if p.cork_law.form != "power":
+            raise NotImplementedError(f"the reference equations have the power-law cork only, "
+                                      f"not the {p.cork_law.form!r} form of cork = {p.cork!r}")
         self.free = np.array(sorted(free))
         self.excitation = excitation or (lambda t: 0.0)
         t, w = np.polynomial.legendre.leggauss(n_gauss)
@@ -199,7 +202,7 @@ class Reference:
 
     def cork(self, s, sd):
         """Cork spring and damper plus the slot's end stop (docs/model.md §6)."""
-        n, k, c = self.p.cork_law
+        n, k, c, _ = self.p.cork_law
         over = max(abs(s) - self.p.s_travel, 0.0)
         return k * np.sign(s) * abs(s) ** n + self.p.k_stop * np.sign(s) * over + c * sd
 
@@ -230,7 +233,7 @@ class Reference:
     def energy(self, y):
         q, qd = y[:N], y[N:]
         M, _, _, Vg = self.inertia(q, qd)
-        n, k, _ = self.p.cork_law
+        n, k, _, _ = self.p.cork_law
         over = max(abs(q[3]) - self.p.s_travel, 0.0)
         return (0.5 * qd @ M @ qd + 0.5 * q @ self.K @ q + Vg + k * abs(q[3]) ** (n + 1) / (n + 1)
                 + 0.5 * self.p.k_stop * over ** 2)
@@ -248,18 +251,20 @@ def shaker(ex):
     Sine F0 sin(2 pi f t) or linear chirp F0 sin(2 pi (f0 t + (f1 - f0) t^2 / 2T)),
     times the soft start 1/2 (1 - cos(pi t / t_ramp)) before t_ramp; written
     out again here, from the array's documented layout, not the kernel's code.
+    Other force shapes raise NotImplementedError.
     """
-    from ..core import layout as ly
-    kind, amp, t_ramp = int(ex[ly.X_KIND]), float(ex[ly.X_AMP]), float(ex[ly.X_RAMP])
-    if kind not in (ly.EXC_SINE, ly.EXC_CHIRP):
-        raise NotImplementedError("the reference drives only sine and chirp excitations")
+    from ..core import excitation as cx
+    kind, amp, t_ramp = int(ex[cx.X_KIND]), float(ex[cx.X_AMP]), float(ex[cx.X_RAMP])
+    if kind not in (cx.EXC_SINE, cx.EXC_CHIRP):
+        raise NotImplementedError(f"the reference drives only sine and chirp excitations, "
+                                  f"not the force shape {kind} (workbench.core.excitation)")
 
     def force(t):
-        if kind == ly.EXC_SINE:
-            phase = ex[ly.X_FREQ] * t
+        if kind == cx.EXC_SINE:
+            phase = ex[cx.X_FREQ] * t
         else:
-            f0 = ex[ly.X_F0]
-            phase = f0 * t + (ex[ly.X_F1] - f0) * t * t / (2.0 * ex[ly.X_T_SWEEP])
+            f0 = ex[cx.X_F0]
+            phase = f0 * t + (ex[cx.X_F1] - f0) * t * t / (2.0 * ex[cx.X_T_SWEEP])
         soft = 1.0 if t >= t_ramp else 0.5 * (1.0 - np.cos(np.pi * max(t, 0.0) / t_ramp))
         return amp * soft * np.sin(2.0 * np.pi * phase)
     return force
