@@ -78,7 +78,7 @@ name = "tiny"
 duration_s = 0.1
 window_s = 0.05
 [excitation]
-kind = "sine"
+drive = "sine"
 force_n = 20.0
 [axes]
 freq_hz = [20.0, 30.0]
@@ -244,7 +244,7 @@ toml_values = st.recursive(
     max_leaves=6)
 STUDY_KEYS = {"study": ["name", "duration_s", "window_s", "sweep", "dt", "output_hz",
                         "save_series", "initial", "description", "bogus"],
-              "excitation": ["kind", "force_n", "freq_hz", "ramp_s", "deflection_cm", "f0_hz"],
+              "excitation": ["drive", "force_n", "freq_hz", "ramp_s", "deflection_cm", "f0_hz"],
               "fixed": ["cork", "mu_s", "gap_mm", "tip_mass", "m6", "bogus"],
               "axes": ["freq_hz", "gap_mm", "cork", "tip_mass", "force_n"]}
 
@@ -284,7 +284,7 @@ def _merge(base, lines):
 #: A list where a word belongs, in every section: (section, key = value, what the line names).
 LIST_WORDS = [("study", 'name = ["tiny"]', "name"), ("study", 'description = ["d"]', "description"),
               ("study", 'sweep = ["up"]', "sweep"), ("study", 'initial = ["paper"]', "initial"),
-              ("study", 'method = ["rk4"]', "method"), ("excitation", 'kind = ["sine"]', "kind"),
+              ("study", 'method = ["rk4"]', "method"), ("excitation", 'drive = ["sine"]', "drive"),
               ("fixed", 'cork = ["cubic"]', "cork"), ("axes", 'cork = [["cubic"]]', "cork")]
 
 

@@ -231,15 +231,15 @@ def _chirp(text: str) -> tuple[float, float, float]:
 
 def _shortcut_drive(args) -> dict | None:
     """The drive of --freq-hz, --chirp, --free-decay, --impulse or --drive, as settings
-    {"kind": ..., key: value} with the keys those options give; None without a drive."""
+    {"drive": ..., key: value} with the keys those options give; None without a drive."""
     if args.freq_hz is not None:
-        return {"kind": "sine", "freq_hz": args.freq_hz}
+        return {"drive": "sine", "freq_hz": args.freq_hz}
     if args.chirp is not None:
-        return dict(zip(("kind", "f0_hz", "f1_hz", "sweep_s"), ("chirp", *args.chirp)))
+        return dict(zip(("drive", "f0_hz", "f1_hz", "sweep_s"), ("chirp", *args.chirp)))
     if args.free_decay is not None:
-        return {"kind": "free_decay", "deflection_cm": args.free_decay}
+        return {"drive": "free_decay", "deflection_cm": args.free_decay}
     if args.impulse is not None:
-        return {"kind": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
+        return {"drive": f"hammer_{args.impulse}", "width_s": args.pulse_s, "t_hit_s": args.hit_s}
     if args.drive is not None:
         return _drive_settings(args)
     return None
@@ -248,7 +248,7 @@ def _shortcut_drive(args) -> dict | None:
 def _run_drive(args) -> dict:
     """The complete drive settings of ``workbench run`` (amplitude and soft start filled)."""
     from .model import drives
-    drive = _shortcut_drive(args) or {"kind": "none"}
+    drive = _shortcut_drive(args) or {"drive": "none"}
     if args.drive is not None:
         for option, value in (("--force-n", args.force_n), ("--ramp-s", args.ramp_s)):
             if value is not None:
@@ -261,14 +261,10 @@ def _run_drive(args) -> dict:
                              "(a hammer's sign gives its direction)")
     if args.free_decay is not None and args.force_n is not None:
         raise ParameterError("--force-n does not apply to --free-decay (a release without drive)")
-    keys = drives.get(drive["kind"]).keys
-    if "force_n" in keys:
-        default = drives.DEFAULT_HAMMER_N if hammer else drives.DEFAULT_FORCE_N
-        drive["force_n"] = default if args.force_n is None else args.force_n
-    if "ramp_s" in keys:
-        drive["ramp_s"] = (min(DEFAULT_RAMP_S, 0.5 * args.duration) if args.ramp_s is None
-                           else args.ramp_s)
-    return drive
+    name = drive.pop("drive")
+    given = {**drive, "force_n": args.force_n, "ramp_s": args.ramp_s}
+    return drives.complete(name, {k: v for k, v in given.items() if v is not None},
+                           lambda key: f"the drive needs {key}", duration_s=args.duration)
 
 
 #: The run options behind the names of :func:`workbench.model.simulate.check_settings`.
@@ -293,7 +289,7 @@ def _cmd_run(args) -> int:
     names = dict(RUN_OPTION_NAMES)
     drive = _run_drive(args)
     if args.drive is not None:
-        names.update({key: f"--drive-set {key}" for key in drive if key != "kind"})
+        names.update({key: f"--drive-set {key}" for key in drive if key != "drive"})
     ex = drives.excitation_array(drive)
     check_settings(p, ex, args.duration, args.dt, args.output_hz, names=names)
     check_method(args.method, args.tol, dt_given=args.dt is not None, names=names)
@@ -393,10 +389,6 @@ def _cmd_report(args) -> int:
     return EXIT_OK
 
 
-#: The soft start of ``workbench run`` (s), or half the run if that is shorter.
-DEFAULT_RAMP_S = 1.0
-
-
 def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") -> None:
     from .model import drives
     drive = parser.add_argument_group("excitation (one; default none)")
@@ -420,18 +412,17 @@ def _add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") ->
 
 
 def _drive_settings(args) -> dict:
-    """The settings {"kind": ..., key: value} of ``--drive`` and its ``--drive-set`` pairs."""
+    """The settings {"drive": ..., key: value} of ``--drive`` and its ``--drive-set`` pairs."""
     from .model import drives
     drive = drives.get(args.drive, where="--drive")
     given = _pair_numbers(args.drive_set, "--drive-set", "VALUE")
     unknown = sorted(set(given) - set(drive.keys))
     if unknown:
         raise ParameterError(f"--drive-set {_cut(unknown[0])}: not a setting of --drive "
-                             f"{drive.kind} (its settings: {', '.join(drive.keys) or 'none'})")
-    if drive.ramped and "ramp_s" not in given and hasattr(args, "duration"):
-        given["ramp_s"] = min(DEFAULT_RAMP_S, 0.5 * args.duration)
-    return drives.complete(drive.kind, given, lambda key: f"--drive {drive.kind} needs "
-                           f"--drive-set {key}=VALUE ({drives.UNITS[key]})")
+                             f"{drive.name} (its settings: {', '.join(drive.keys) or 'none'})")
+    return drives.complete(drive.name, given, lambda key: f"--drive {drive.name} needs "
+                           f"--drive-set {key}=VALUE ({drives.UNITS[key]})",
+                           duration_s=getattr(args, "duration", None))
 
 
 def _record_settings(args, meta: dict) -> dict:
@@ -445,8 +436,6 @@ def _record_settings(args, meta: dict) -> dict:
         settings.update(mu_s=args.mu, mu_k=args.mu)
     settings.update({name: _value(text) for name, text in _pairs(args.set, "--set").items()})
     drive = _shortcut_drive(args)
-    if drive:
-        drive = {"drive": drive.pop("kind"), **drive}
     if drive:                  # a drive given here replaces the file's (its amplitude may stay)
         for key in set(drives.all_keys()) - {"force_n", "ramp_s"} | {"drive"}:
             settings.pop(key, None)
@@ -549,9 +538,9 @@ def _cmd_compare(args) -> int:
         if args.params else None
     setup = setup_from(_record_settings(args, record.attrs["meta"]), record, base)
     run = setup.simulate()
-    title = f"{Path(args.file).name} vs simulation ({setup.excitation['kind']})"
+    title = f"{Path(args.file).name} vs simulation ({setup.excitation['drive']})"
     result = compare(record, run, out, skip_s=args.skip_s, threshold=args.threshold,
-                     chirp=drives.DRIVES[setup.excitation["kind"]].swept,
+                     chirp=drives.DRIVES[setup.excitation["drive"]].swept,
                      band=drives.band_hz(setup.excitation), title=title)
     print(json_text({"record": args.file, "simulation_status": run.status, "out": str(out),
                       "figures": [str(p) for p in result.figures if p.suffix == ".png"],
@@ -652,6 +641,7 @@ def _cmd_identify_decrement(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .model import drives
     parser = _Parser(
         prog="workbench", description="Loose bolted lap joint workbench (9-DOF Gibbs-Appell model).")
     parser.add_argument("--version", action="version", version=f"workbench {__version__}")
@@ -668,7 +658,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_model_options(run)
     _add_joint_options(run)
     _add_drive_options(run, ramp_help=f"soft-start ramp of sine/chirp (s); default "
-                                      f"{DEFAULT_RAMP_S:g} s, or half the run if shorter")
+                                      f"{drives.DEFAULTS['ramp_s']:g} s, or half the run if shorter")
     run.add_argument("--duration", type=_number(0, MAX_DURATION_S, lo_open=True), default=1.0, help="simulated time (s)")
     run.add_argument("--dt", type=_number(MIN_DT, MAX_DT),
                      help="fixed RK4 step (s; implies --method rk4 unless --tol is given); default "

@@ -19,7 +19,7 @@ from workbench.model.params import Parameters
 SUFFIXES = {"lvm": ".lvm", "text": ".txt", "tdms": ".tdms", "uff": ".uff", "parquet": ".parquet"}
 #: Digits each format keeps: the text formats write 10 significant digits, UFF 12.
 RTOL = {"lvm": 1e-9, "text": 1e-9, "tdms": 0.0, "uff": 1e-10, "parquet": 0.0}
-DRIVE = {"kind": "sine", "force_n": 120.0, "freq_hz": 25.0, "ramp_s": 0.1}
+DRIVE = {"drive": "sine", "force_n": 120.0, "freq_hz": 25.0, "ramp_s": 0.1}
 PARAMS = Parameters().replace(gap_mm=0.635, tip_mass=False, cork="linear")
 
 

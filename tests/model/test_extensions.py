@@ -23,6 +23,8 @@ import workbench
 
 PACKAGE = Path(workbench.__file__).parent
 
+#: The anchor of a text added at the end of a file.
+END = None
 #: file: [(anchor, text put after the anchor)]: the whole of each extension.
 EDITS = {
     "core/excitation.py": [
@@ -35,7 +37,7 @@ EDITS = {
          "                                  + math.sin(2.0 * math.pi * ex[X_F1] * t))\n"),
     ],
     "model/drives.py": [
-        ("code=cx.EXC_HAMMER_TIP, check=_check_pulse, dt_max=_pulse_dt))\n", textwrap.dedent("""\
+        (END, textwrap.dedent("""\
 
 
             def two_tone(force_n, f0_hz, f1_hz):
@@ -87,7 +89,7 @@ SCRIPT = textwrap.dedent("""\
 
     out = {}
     p = Parameters().replace(gap_mm=1.016)
-    ex = drives.excitation_array({"kind": "two_tone", "force_n": 10.0, "f0_hz": 20.0, "f1_hz": 30.0})
+    ex = drives.excitation_array({"drive": "two_tone", "force_n": 10.0, "f0_hz": 20.0, "f1_hz": 30.0})
     run = simulate(p, ex, 0.005)
     t = run.signals.index.to_numpy()
     want = 0.5 * 10.0e5 * (np.sin(2 * np.pi * 20.0 * t) + np.sin(2 * np.pi * 30.0 * t))
@@ -126,6 +128,9 @@ def _extend(root: Path) -> Path:
         path = copy / name
         text = path.read_text()
         for anchor, added in edits:
+            if anchor is END:
+                text += added
+                continue
             assert text.count(anchor) == 1, f"{name}: the anchor {anchor!r} moved"
             text = text.replace(anchor, anchor + added)
         path.write_text(text)

@@ -37,7 +37,7 @@ duration_s = 0.2
 window_s = 0.1
 
 [excitation]
-kind = "sine_rms"
+drive = "sine_rms"
 force_n = 10.0
 
 [axes]
@@ -57,7 +57,7 @@ def test_a_registered_drive_is_a_study_excitation_and_a_record_drive(sine_rms, t
     # a record that says WB_drive = sine_rms is matched by the same drive
     record = pd.DataFrame({"force1": np.zeros(101)}, index=pd.Index(np.arange(101) * 1e-3, name="t"))
     setup = setup_from({"drive": "sine_rms", "freq_hz": 25.0, "force_n": 3.0}, record)
-    assert setup.excitation == {"kind": "sine_rms", "force_n": 3.0, "freq_hz": 25.0, "ramp_s": 0.0}
+    assert setup.excitation == {"drive": "sine_rms", "force_n": 3.0, "freq_hz": 25.0, "ramp_s": 0.05}
     # a setting the drive does not take is refused, naming it
     with pytest.raises(ParameterError, match="f0_hz does not apply"):
         setup_from({"drive": "sine_rms", "freq_hz": 25.0, "f0_hz": 5.0}, record)
@@ -71,7 +71,7 @@ def test_an_unknown_drive_names_the_kinds():
 
 
 def test_a_free_decay_is_a_start_not_a_force():
-    settings = {"kind": "free_decay", "deflection_cm": 2.0}
+    settings = {"drive": "free_decay", "deflection_cm": 2.0}
     assert drives.start_keywords(settings) == {"free_decay_cm": 2.0}
     assert int(drives.excitation_array(settings)[cx.X_KIND]) == cx.EXC_NONE
     assert drives.drive_hz(settings) is None

@@ -24,7 +24,7 @@ window_s = 0.2
 save_series = [{gap_mm = 1.016, freq_hz = 20.0}]
 
 [excitation]
-kind = "sine"
+drive = "sine"
 force_n = 20.0
 ramp_s = 0.1
 
@@ -295,7 +295,7 @@ window_s = 0.5
 save_series = [{gap_mm = 1.016}]
 
 [excitation]
-kind = "chirp"
+drive = "chirp"
 f0_hz = 5.0
 f1_hz = 65.0
 sweep_s = 1.0

@@ -84,7 +84,7 @@ def _apply(setup: Setup, values: dict[str, float]) -> Setup:
         where = FITTABLE[name][0]
         if where == "excitation":
             if name not in exc:
-                raise ParameterError(f"{name} is not a setting of a {exc['kind']} drive")
+                raise ParameterError(f"{name} is not a setting of a {exc['drive']} drive")
             exc[name] = value
         elif where == "mu":
             params.update(mu_s=value, mu_k=value)

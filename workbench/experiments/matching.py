@@ -44,14 +44,19 @@ def settings_of(excitation: dict, params: Parameters) -> dict:
     """The settings to write with a simulated record (``WB_`` keys), which
     :func:`setup_from` reads back: the drive, its settings, and the model parameters
     that differ from the defaults (CGS names)."""
-    exc = dict(excitation)
-    return {"drive": exc.pop("kind"), **exc, **params.changed()}
+    return {**excitation, **params.changed()}
 
 
 def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = None) -> Setup:
     """The Setup of ``record`` from its settings (module docstring)."""
     settings = dict(settings)
     kind = settings.pop("drive", "none")
+    t = record.index.to_numpy(dtype=float)
+    rate = 1.0 / float(np.median(np.diff(t)))
+    output_hz = float(round(rate))
+    if abs(output_hz - rate) > 1e-6 * rate:
+        raise ParameterError(f"the record's sample rate {rate} Hz is not a whole number of Hz")
+    duration = round(float(t[-1] - t[0]) * output_hz) / output_hz
     given = {}
     for key in drives.get(kind, where="drive").keys:
         if key in settings:
@@ -62,17 +67,12 @@ def setup_from(settings: dict, record: pd.DataFrame, base: Parameters | None = N
                 raise ParameterError(f"{key} = {value!r} is not a number (WB_{key} in the file, "
                                      "or its option)") from None
     exc = drives.complete(kind, given, lambda key: f"a {kind} drive needs {key} (in the file as "
-                          f"WB_{key}, or on the command line)", where="drive")
+                          f"WB_{key}, or on the command line)", where="drive",
+                          duration_s=duration)
     for key in [k for k in settings if k in drives.all_keys()]:
         raise ParameterError(f"{key} does not apply to a {kind} drive")
     for key in settings:
         resolve_name(key)                 # names the parameter if it is unknown
     params = (base or Parameters()).replace(**settings) if settings else (base or Parameters())
-    t = record.index.to_numpy(dtype=float)
-    rate = 1.0 / float(np.median(np.diff(t)))
-    output_hz = float(round(rate))
-    if abs(output_hz - rate) > 1e-6 * rate:
-        raise ParameterError(f"the record's sample rate {rate} Hz is not a whole number of Hz")
-    duration = round(float(t[-1] - t[0]) * output_hz) / output_hz
     drives.excitation_array(exc)          # validates the values
     return Setup(params, exc, duration, output_hz)

@@ -1,6 +1,6 @@
 """The drives a run can have, in one registry, with the excitation arrays they build.
 
-A drive is named by its kind (``sine``, ``chirp``, ...) and set by a few
+A drive is named (``sine``, ``chirp``, ...) and set by a few
 settings in user units (``force_n``, ``freq_hz``, ...): the keys of a
 study's ``[excitation]`` table, of an experiment file's ``WB_`` settings,
 and of ``workbench compare``'s options.  Each :class:`Drive` says which
@@ -34,9 +34,10 @@ DEFAULT_FORCE_N = 200.0
 #: Default hammer peak (N).
 DEFAULT_HAMMER_N = 100.0
 
-#: Defaults of the settings a drive may leave out (user units).
-#: A hammer hits 10 ms into the record, as a lab's pretrigger keeps the record's start quiet.
-DEFAULTS = {"force_n": DEFAULT_FORCE_N, "ramp_s": 0.0, "width_s": 1e-3, "t_hit_s": 0.01,
+#: Defaults of the settings a drive may leave out (user units; a drive may have its
+#: own, :meth:`Drive.default`).  A hammer hits 10 ms into the record, as a lab's pretrigger
+#: keeps the record's start quiet; a shaker starts softly over 1 s (at most half the run).
+DEFAULTS = {"force_n": DEFAULT_FORCE_N, "ramp_s": 1.0, "width_s": 1e-3, "t_hit_s": 0.01,
             "deflection_cm": 8.4}
 #: The unit of every setting.
 UNITS = {"force_n": "N", "freq_hz": "Hz", "f0_hz": "Hz", "f1_hz": "Hz", "sweep_s": "s",
@@ -165,7 +166,7 @@ def _pulse_dt(ex) -> float:
 class Drive:
     """One kind of drive (module docstring)."""
 
-    kind: str
+    name: str
     keys: tuple[str, ...]                          # its settings, in order
     build: Callable[[dict], np.ndarray]            # settings -> the kernel's excitation array
     code: int = cx.EXC_NONE                        # the array's force shape (core.excitation)
@@ -175,6 +176,15 @@ class Drive:
     frequency_key: str | None = None               # the setting that is the forcing frequency
     swept: bool = False                            # the frequency sweeps over the run (chirp figures)
     start: Callable[[dict], dict] = field(default=lambda settings: {})   # simulate() keywords
+    defaults: dict = field(default_factory=dict)   # its own defaults, before DEFAULTS
+
+    def default(self, key: str, duration_s: float | None = None):
+        """The default of a setting (its own, else DEFAULTS; None if it has none); the soft
+        start ``ramp_s`` at most half of a run of ``duration_s`` seconds."""
+        value = self.defaults.get(key, DEFAULTS.get(key))
+        if key == "ramp_s" and value is not None and duration_s is not None:
+            value = min(value, 0.5 * duration_s)
+        return value
 
 
 DRIVES: dict[str, Drive] = {}
@@ -184,16 +194,16 @@ def register(drive: Drive) -> Drive:
     """Add (or replace) a drive; every key needs a unit in UNITS."""
     unknown = [k for k in drive.keys if k not in UNITS]
     if unknown:
-        raise ValueError(f"drive {drive.kind!r}: settings without a unit in UNITS: {unknown}")
-    DRIVES[drive.kind] = drive
+        raise ValueError(f"drive {drive.name!r}: settings without a unit in UNITS: {unknown}")
+    DRIVES[drive.name] = drive
     return drive
 
 
-def get(kind: str, where: str = "kind") -> Drive:
-    """The drive of that kind, or a ParameterError naming ``where`` and the kinds allowed."""
-    if kind not in DRIVES:
-        raise ParameterError(f"{where} = {kind!r}; allowed: {', '.join(sorted(DRIVES))}")
-    return DRIVES[kind]
+def get(name: str, where: str = "drive") -> Drive:
+    """The drive of that name, or a ParameterError naming ``where`` and the drives allowed."""
+    if name not in DRIVES:
+        raise ParameterError(f"{where} = {name!r}; allowed: {', '.join(sorted(DRIVES))}")
+    return DRIVES[name]
 
 
 def of_array(ex: np.ndarray) -> Drive:
@@ -205,17 +215,18 @@ def of_array(ex: np.ndarray) -> Drive:
     raise ParameterError(f"the excitation array's force shape {code} is no registered drive's")
 
 
-def complete(kind: str, given: dict, needs: Callable[[str], str], where: str = "kind") -> dict:
-    """The settings {"kind": kind, key: value} of a drive: each key's value given, else its
-    default; a key with neither raises a ParameterError saying ``needs(key)`` (how to give
-    it, in the caller's words)."""
-    drive = get(kind, where)
-    settings = {"kind": drive.kind}
+def complete(name: str, given: dict, needs: Callable[[str], str], where: str = "drive",
+             duration_s: float | None = None) -> dict:
+    """The settings {"drive": name, key: value} of a drive: each key's value given, else its
+    default (:meth:`Drive.default` for a run of ``duration_s``); a key with neither raises a
+    ParameterError saying ``needs(key)`` (how to give it, in the caller's words)."""
+    drive = get(name, where)
+    settings = {"drive": drive.name}
     for key in drive.keys:
         if key in given:
             settings[key] = given[key]
-        elif key in DEFAULTS:
-            settings[key] = DEFAULTS[key]
+        elif drive.default(key) is not None:
+            settings[key] = drive.default(key, duration_s)
         else:
             raise ParameterError(needs(key))
     return settings
@@ -227,10 +238,10 @@ def all_keys() -> list[str]:
 
 
 def excitation_array(settings: dict, first_in_chain: bool = True) -> np.ndarray:
-    """The kernel's excitation array of {"kind": ..., key: value} (every key of the kind
+    """The kernel's excitation array of {"drive": ..., key: value} (every key of the drive
     present, user units); a ramped drive not first in a stepped chain has no soft start."""
     e = dict(settings)
-    drive = get(e.pop("kind"))
+    drive = get(e.pop("drive"))
     if drive.ramped and not first_in_chain:
         e["ramp_s"] = 0.0
     return drive.build(e)
@@ -238,19 +249,19 @@ def excitation_array(settings: dict, first_in_chain: bool = True) -> np.ndarray:
 
 def start_keywords(settings: dict) -> dict:
     """The keywords of :func:`~workbench.model.simulate.simulate` that set the drive's start."""
-    return get(settings["kind"]).start(settings)
+    return get(settings["drive"]).start(settings)
 
 
 def band_hz(settings: dict) -> tuple[float, float] | None:
     """The frequency band (Hz) a swept drive covers, else None."""
-    if not get(settings["kind"]).swept:
+    if not get(settings["drive"]).swept:
         return None
     return tuple(sorted((settings["f0_hz"], settings["f1_hz"])))
 
 
 def drive_hz(settings: dict) -> float | None:
     """The forcing frequency (Hz) of a drive that has one, else None."""
-    key = get(settings["kind"]).frequency_key
+    key = get(settings["drive"]).frequency_key
     return settings.get(key) if key else None
 
 
@@ -262,6 +273,8 @@ register(Drive("chirp", ("force_n", "f0_hz", "f1_hz", "sweep_s", "ramp_s"), lamb
 register(Drive("free_decay", ("deflection_cm",), lambda e: none(),
                start=lambda e: {"free_decay_cm": e["deflection_cm"]}))
 register(Drive("hammer_joint", ("force_n", "width_s", "t_hit_s"), lambda e: hammer_joint(**e),
-               code=cx.EXC_HAMMER_JOINT, check=_check_pulse, dt_max=_pulse_dt))
+               code=cx.EXC_HAMMER_JOINT, check=_check_pulse, dt_max=_pulse_dt,
+               defaults={"force_n": DEFAULT_HAMMER_N}))
 register(Drive("hammer_tip", ("force_n", "width_s", "t_hit_s"), lambda e: hammer_tip(**e),
-               code=cx.EXC_HAMMER_TIP, check=_check_pulse, dt_max=_pulse_dt))
+               code=cx.EXC_HAMMER_TIP, check=_check_pulse, dt_max=_pulse_dt,
+               defaults={"force_n": DEFAULT_HAMMER_N}))

@@ -38,7 +38,7 @@ RESPONSES = tuple(c for c in CHANNELS if kind(c) in ("accel", "strain"))
 
 def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     has = {a for a in ("gap_mm", "freq_hz") if f"axis_{a}" in table and table[f"axis_{a}"].nunique() > 1}
-    frequency = drives.DRIVES[study.excitation["kind"]].frequency_key
+    frequency = drives.DRIVES[study.excitation["drive"]].frequency_key
     sine = frequency == "freq_hz" and "freq_hz" in has
     figs = {}
     if not (table.status == "ok").any():
@@ -69,7 +69,7 @@ def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
     yield f"time_history_{tag}", lambda: F.time_history(sig, row.static_tip_y, title, short)
     yield f"strain_spectra_{tag}", lambda: F.strain_spectra(sig, title, study.window_s)
     yield f"switching_{tag}", lambda: F.switching_diagram(ev, t_end, title, short)
-    if drives.DRIVES[study.excitation["kind"]].swept:
+    if drives.DRIVES[study.excitation["drive"]].swept:
         yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
         responses = [c for c in sig.columns if c in RESPONSES]
         f_lo, f_hi = drives.band_hz(study.excitation)

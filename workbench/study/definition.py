@@ -14,7 +14,7 @@
                                      # (each selector names axis values; {} selects every point)
 
     [excitation]
-    kind = "sine"                    # a drive of model/drives.py: sine, chirp, free_decay, hammer_joint, hammer_tip, none
+    drive = "sine"                   # a drive of model/drives.py: sine, chirp, free_decay, hammer_joint, hammer_tip, none
     force_n = 20.0
     ramp_s = 1.0                     # soft start (s)
 
@@ -65,7 +65,7 @@ class Point:
 
     values: dict            # axis name -> value (user units), in axis order
     params: Parameters
-    excitation: dict        # kind and its settings (user units)
+    excitation: dict        # the drive ("drive": its name) and its settings (user units)
     chain: int = 0          # stepped sweeps: the points of one chain share all but freq_hz
     step: int = 0           # position within the chain
     direction: str = ""     # "up" or "down" in a stepped sweep
@@ -188,10 +188,10 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     if initial not in ("static", "paper"):
         raise StudyError(f"[study] initial = {initial!r}; allowed: 'static', 'paper'")
 
-    exc = dict(data.get("excitation", {"kind": "none"}))
-    kind = exc.pop("kind", None)
-    if not isinstance(kind, str) or kind not in drives.DRIVES:
-        raise StudyError(f"[excitation] kind = {kind!r}; allowed: {sorted(drives.DRIVES)}")
+    exc = dict(data.get("excitation", {"drive": "none"}))
+    drive = exc.pop("drive", None)
+    if not isinstance(drive, str) or drive not in drives.DRIVES:
+        raise StudyError(f"[excitation] drive = {drive!r}; allowed: {sorted(drives.DRIVES)}")
     fixed = dict(data.get("fixed", {}))
     axes = dict(data.get("axes", {}))
     for key, values in axes.items():
@@ -203,7 +203,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                                  f"string, got {_short(v)}")
         if len(set(map(_value_key, values))) != len(values):
             raise StudyError(f"[axes] {key} lists a value twice: {_short(values)}")
-    allowed_exc = set(drives.DRIVES[kind].keys)
+    allowed_exc = set(drives.DRIVES[drive].keys)
     for key, value in list(exc.items()) + list(fixed.items()):
         if not isinstance(value, (bool, int, float, str)):
             table = "excitation" if key in exc else "fixed"
@@ -217,19 +217,20 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                                      "[excitation] or [axes]")
                 continue
             if key in drives.all_keys():
-                raise StudyError(f"[{table}] {key} does not apply to a {kind!r} excitation "
+                raise StudyError(f"[{table}] {key} does not apply to a {drive!r} excitation "
                                  f"(its settings: {sorted(allowed_exc)})")
             if table == "excitation":
-                raise StudyError(f"[excitation] unknown key {key!r}; a {kind!r} excitation "
+                raise StudyError(f"[excitation] unknown key {key!r}; a {drive!r} excitation "
                                  f"takes {sorted(allowed_exc)}")
             resolve_name(key)                      # raises, with a suggestion, if unknown
     both = sorted(set(axes) & (set(fixed) | set(exc)))
     if both:
         raise StudyError(f"{both} given both as an axis and as a fixed value")
-    missing = sorted(k for k in allowed_exc - set(exc) - set(axes) - set(drives.DEFAULTS))
+    missing = sorted(k for k in allowed_exc - set(exc) - set(axes)
+                     if drives.DRIVES[drive].default(k) is None)
     if missing:
-        raise StudyError(f"a {kind!r} excitation needs {missing} in [excitation] or [axes]")
-    frequency = drives.DRIVES[kind].frequency_key
+        raise StudyError(f"a {drive!r} excitation needs {missing} in [excitation] or [axes]")
+    frequency = drives.DRIVES[drive].frequency_key
     if sweep != "independent" and (frequency is None or frequency not in axes):
         raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a drive "
                          "with a forcing frequency (a sine) with that frequency in [axes]")
@@ -244,9 +245,9 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         model_values = {**fixed, **{k: v for k, v in values.items() if k not in allowed_exc}}
         try:
             params = Parameters.from_user(model_values)
-            settings = {"kind": kind}
-            for k in drives.DRIVES[kind].keys:
-                settings[k] = values.get(k, exc.get(k, drives.DEFAULTS.get(k)))
+            settings = {"drive": drive}
+            for k in drives.DRIVES[drive].keys:
+                settings[k] = values.get(k, exc.get(k, drives.DRIVES[drive].default(k, duration)))
             pt = Point(values=values, params=params, excitation=settings)
             _check_point(pt, duration, dt, output_hz, where)
         except StudyError:
@@ -270,7 +271,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
             raise StudyError(f"[study] save_series selects by {bad}, which are not axes")
     return Study(name=name, description=str(head.get("description", "")), duration_s=duration,
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
-                 excitation={"kind": kind, **exc}, fixed=fixed, axes=axes, save_series=series,
+                 excitation={"drive": drive, **exc}, fixed=fixed, axes=axes, save_series=series,
                  source=source, points=tuple(points), method=method, tol=tol)
 
 
@@ -294,7 +295,7 @@ def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     """A point's excitation values, and its run settings against what the step resolves."""
     from ..model.simulate import check_settings
     ex = point.excitation_array()                  # validates the excitation values
-    if point.excitation["kind"] == "free_decay":
+    if point.excitation["drive"] == "free_decay":
         x = point.excitation.get("deflection_cm")
         ok = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
         if not ok or abs(x) > FREE_DECAY_MAX_CM:
