@@ -195,7 +195,8 @@ def test_dry_run_shows_grid_and_cost(files, capsys):
 def test_internal_error_is_one_line_with_a_traceback_file(monkeypatch, tmp_path, capsys):
     def broken(args):
         raise ZeroDivisionError("boom")
-    monkeypatch.setattr(cli, "_cmd_params", broken)
+    from workbench.cli import simulation
+    monkeypatch.setattr(simulation, "_cmd_params", broken)
     code, err = outcome(["params"], capsys)
     assert code == cli.EXIT_INTERNAL
     line = err.strip()

@@ -14,6 +14,7 @@ LAYERS = {
     "identify": {"core", "model", "study"},
     "experiments": {"core", "model", "study", "identify"},
     "present": {"core", "model", "study", "identify", "experiments"},
+    "cli": {"core", "model", "reference", "study", "identify", "experiments", "present"},
 }
 
 def imported_packages(path: Path) -> set[str]:

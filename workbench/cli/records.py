@@ -1,0 +1,171 @@
+"""``workbench convert``, ``compare``, ``frf`` and ``estimate``: lab records read,
+written, set beside their simulation, turned into FRFs, and fitted."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..model.params import ParameterError, Parameters
+from ..study.paths import check_output_dir, check_output_file
+from .common import (EXIT_NOT_CONVERGED, EXIT_OK, EXIT_RUN_FAILED, RESULTS, add_format_option,
+                     add_jobs_option, add_record_options, check_window, cut,
+                     json_text, number, pair_numbers, read_record,
+                     record_settings, strain_scale, with_option)
+
+
+def _cmd_convert(args) -> int:
+    from ..experiments import files
+    source_format = files.format_of(args.source, args.source_format, option="--from")
+    target_format = files.format_of(args.target, args.target_format, option="--to")
+    check_output_file("TARGET", args.target)
+    if Path(args.target).resolve() == Path(args.source).resolve():
+        raise ParameterError(f"TARGET {args.target}: is the SOURCE; write to another file")
+    record = files.convert(args.source, args.target, strain_scale(args), source_format,
+                           target_format)
+    t = record.index.to_numpy()
+    print(json_text({"source": args.source, "target": args.target, "format": target_format,
+                     "channels": list(record.columns), "samples": len(record),
+                     "duration_s": float(t[-1] - t[0]), "settings": record.attrs["meta"],
+                     "units_assumed": record.attrs["units_assumed"]}))
+    return EXIT_OK
+
+
+def _cmd_compare(args) -> int:
+    from ..present.comparison import compare
+    from ..model import drives
+    from ..experiments.matching import setup_from
+
+    from ..experiments.compare import SIGNALS
+    record = read_record(args, args.file)
+    check_window(args.file, record, args.skip_s)
+    if not any(c in record.columns for c in SIGNALS):
+        raise ParameterError(f"{args.file}: no signal channel to compare (has "
+                             f"{list(record.columns)}; signals: {list(SIGNALS)})")
+    out = check_output_dir("--out", args.out or RESULTS / "compare" / Path(args.file).stem)
+    base = with_option(f"--params {args.params}", Parameters.from_toml, args.params) \
+        if args.params else None
+    setup = setup_from(record_settings(args, record.attrs["meta"]), record, base)
+    run = setup.simulate()
+    title = f"{Path(args.file).name} vs simulation ({setup.excitation['drive']})"
+    result = compare(record, run, out, skip_s=args.skip_s, threshold=args.threshold,
+                     chirp=drives.DRIVES[setup.excitation["drive"]].swept,
+                     band=drives.band_hz(setup.excitation), title=title)
+    print(json_text({"record": args.file, "simulation_status": run.status, "out": str(out),
+                      "figures": [str(p) for p in result.figures if p.suffix == ".png"],
+                      "rms_error_rel": dict(zip(result.signals.channel,
+                                                result.signals.rms_error_rel.round(4)))}))
+    return EXIT_OK if run.ok else EXIT_RUN_FAILED
+
+
+def _cmd_frf(args) -> int:
+    from ..experiments.formats import uff
+    from ..experiments.frf import frf, magnitude_phase, peak_table as peak_table_of, responses_of
+    from ..present.figures import frf_figure, save
+
+    path = Path(args.file)
+    record = read_record(args, args.file)
+    meta = record.attrs.get("meta", {})
+    uff.check_settings(Path(args.file), meta, records=len(args.response) or sum(
+        str(c).startswith(("accel", "strain")) for c in record.columns))
+    check_window(args.file, record, args.skip_s)
+    t = record.index.to_numpy()
+    length = (t[-1] - t[0] - args.skip_s) * len(t) / max(len(t) - 1, 1)    # samples x dt
+    if args.segment_s > length * (1 + 1e-9):
+        raise ParameterError(f"--segment-s {args.segment_s:g}: longer than {args.file} after "
+                             f"--skip-s; allowed: (0, {length:g}] s")
+    out = check_output_dir("--out", args.out or RESULTS / "frf" / path.stem)
+    out.mkdir(parents=True, exist_ok=True)
+    table = frf(record, args.response or None, force=args.force, segment_s=args.segment_s,
+                skip_s=args.skip_s)
+    responses = responses_of(table)
+    magnitude_phase(table).to_csv(out / "frf.csv")
+    peak_table = peak_table_of({args.file: table}, responses, args.f_min,
+                               args.f_max).drop(columns="source")
+    peak_table.to_csv(out / "peaks.csv", index=False)
+    (out / "peaks.md").write_text("# FRF peaks (H1): frequency (Hz), magnitude in its unit, "
+                                  "coherence, half-power damping ratio\n\n"
+                                  + peak_table.to_markdown(index=False, floatfmt=".4g") + "\n")
+    figures = save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against "
+                              f"{args.force}", args.f_max), out / "frf")
+    uff.write_frf(out / "frf.uff", table, responses, args.force, meta=meta)
+    print(json_text({"record": args.file, "out": str(out), "resolution_hz": float(table.index[1]),
+                     "uff": str(out / "frf.uff"),
+                     "figures": [str(p) for p in figures if p.suffix == ".png"],
+                     "peaks": peak_table.to_dict("records")}))
+    return EXIT_OK
+
+
+def _cmd_estimate(args) -> int:
+    from ..experiments.estimate import estimate
+    from ..experiments.matching import setup_from
+
+    from ..experiments.estimate import FITTABLE
+    start = pair_numbers(args.fit, "--fit", "START", 0, lo_open=True)
+    unknown = sorted(set(start) - set(FITTABLE))
+    if unknown:
+        raise ParameterError(f"--fit {', '.join(cut(u) for u in unknown)}: not fittable; "
+                             f"fittable are {', '.join(FITTABLE)}")
+    if args.out:
+        check_output_file("--out", args.out, (".csv",))
+    base = with_option(f"--params {args.params}", Parameters.from_toml, args.params) \
+        if args.params else None
+    pairs = []
+    for path in args.files:
+        record = read_record(args, path)
+        check_window(path, record, args.skip_s)
+        pairs.append((record, setup_from(record_settings(args, record.attrs["meta"]), record, base)))
+    fit = estimate(pairs, start, skip_s=args.skip_s, jobs=args.jobs, max_nfev=args.max_nfev)
+    table = fit.table()
+    if args.out:
+        table.to_csv(args.out, index=False)
+    print(json_text({"values": fit.values, "intervals_2sigma": fit.intervals, "cost": fit.cost,
+                      "simulations": fit.n_simulations, "success": fit.success,
+                      "message": fit.message, "wall_s": round(fit.wall_s, 1)}))
+    return EXIT_OK if fit.success else EXIT_NOT_CONVERGED
+
+
+def add_parsers(sub) -> None:
+    """Add this module's sub-commands to the parser's ``sub``."""
+    compare = sub.add_parser("compare", help="a measurement file against the matching simulation")
+    compare.add_argument("file", help="a .lvm or tab-delimited record (Table 2 channels)")
+    add_record_options(compare)
+    compare.add_argument("--threshold", type=number(0, lo_open=True), default=0.5,
+                         help="contact patch voltage that counts as touched (V)")
+    compare.add_argument("--out", help="output folder (default results/compare/<file stem>)")
+    compare.set_defaults(func=_cmd_compare)
+
+    fr = sub.add_parser("frf", help="H1, H2 and coherence of a record or a run against its force")
+    fr.add_argument("file", help="a record (.lvm .txt .tdms .uff .parquet), e.g. of workbench run --out")
+    fr.add_argument("--force", default="force1", help="the force channel (default force1)")
+    fr.add_argument("--response", action="append", default=[],
+                    help="a response channel, repeatable (default: every accel and strain)")
+    fr.add_argument("--segment-s", type=number(0, lo_open=True), default=2.0,
+                    help="Welch segment (s): the frequency resolution is 1/segment (default 2)")
+    fr.add_argument("--skip-s", type=number(0), default=0.0, help="leave out the first seconds")
+    fr.add_argument("--f-min", type=number(0), default=0.0, help="lowest peak frequency (Hz)")
+    fr.add_argument("--f-max", type=number(0, lo_open=True), default=None,
+                    help="highest frequency shown and searched for peaks (Hz)")
+    fr.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
+                    help="scale factor of a strain channel recorded in V (strain per volt)")
+    add_format_option(fr)
+    fr.add_argument("--out", help="output folder (default results/frf/<file stem>)")
+    fr.set_defaults(func=_cmd_frf)
+
+    conv = sub.add_parser("convert", help="write a record in another format (.lvm .txt .tdms .uff .parquet)")
+    conv.add_argument("source", help="the record to read")
+    conv.add_argument("target", help="the file to write (its format by its suffix or --to)")
+    add_format_option(conv, "--from", "source_format", "the source's format")
+    add_format_option(conv, "--to", "target_format", "the target's format")
+    conv.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
+                      help="scale factor of a strain channel recorded in V (strain per volt)")
+    conv.set_defaults(func=_cmd_convert)
+
+    est = sub.add_parser("estimate", help="fit model parameters to measurement files (§7.2)")
+    est.add_argument("files", nargs="+", help="records (.lvm or tab-delimited)")
+    est.add_argument("--fit", metavar="NAME=START", action="append", required=True,
+                     help="a parameter to fit and its start (CGS; force_n in N), repeatable; "
+                          "fittable: e_a, e_b, zeta_a, zeta_b, mu, cork_k, cork_c, force_n")
+    add_record_options(est)
+    add_jobs_option(est, "worker processes")
+    est.add_argument("--max-nfev", type=number(1, 100000, integer=True), default=30, help="most residual evaluations")
+    est.add_argument("--out", metavar="FILE.csv", help="write the fitted values")
+    est.set_defaults(func=_cmd_estimate)

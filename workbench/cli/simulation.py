@@ -1,0 +1,177 @@
+"""``workbench run``, ``modes``, ``params`` and ``compile``: one simulation, the
+linear model's modes, the parameter table, the kernels' compile."""
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+
+from ..model.limits import DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_OUTPUT_HZ, MIN_DT
+from ..model.params import ParameterError, describe
+from ..study.paths import check_output_file
+from .common import (EXIT_INTERNAL, EXIT_OK, EXIT_RUN_FAILED, add_drive_options, add_joint_options,
+                     add_model_options, json_text, number, parameters_of,
+                     shortcut_drive)
+
+
+def _cmd_modes(args) -> int:
+    from ..model.modes import natural_frequencies
+    p = parameters_of(args)
+    freqs = natural_frequencies(p, args.joint)
+    if args.json:
+        print(json_text({"frequencies_hz": [float(f) for f in freqs], "joint": args.joint,
+                          "tip_mass": p.tip_mass, "cork": p.cork}))
+    else:
+        print(f"Natural frequencies, joint {args.joint}, tip mass {'on' if p.tip_mass else 'off'}, "
+              f"cork {p.cork} (linearised about the undeformed state):")
+        for i, f in enumerate(freqs, 1):
+            print(f"  mode {i}: {f:12.4f} Hz")
+    return EXIT_OK
+
+
+def _cmd_compile(args) -> int:
+    from ..core._cache import CACHE_DIR
+    from ..model.warmup import compile_all
+    print(f"workbench: compiling the numba kernels into {CACHE_DIR} ({args.jobs} processes)",
+          file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    failed = 0
+    for name, seconds, error in compile_all(args.jobs):
+        print(f"  {name}: {seconds:.0f} s" + (f" FAILED: {error}" if error else ""))
+        failed += bool(error)
+    print(f"  total wall time {time.perf_counter() - t0:.0f} s")
+    return EXIT_INTERNAL if failed else EXIT_OK
+
+
+def _run_drive(args) -> dict:
+    """The complete drive settings of ``workbench run`` (amplitude and soft start filled)."""
+    from ..model import drives
+    drive = shortcut_drive(args) or {"drive": "none"}
+    if args.drive is not None:
+        for option, value in (("--force-n", args.force_n), ("--ramp-s", args.ramp_s)):
+            if value is not None:
+                raise ParameterError(f"{option} {value:g}: with --drive, give --drive-set "
+                                     f"{option[2:].replace('-', '_')}=VALUE")
+        return drive
+    hammer = args.impulse is not None
+    if args.force_n is not None and args.force_n < 0 and not hammer:
+        raise ParameterError(f"--force-n {args.force_n:g}: a shaker amplitude must be >= 0 N "
+                             "(a hammer's sign gives its direction)")
+    if args.free_decay is not None and args.force_n is not None:
+        raise ParameterError("--force-n does not apply to --free-decay (a release without drive)")
+    name = drive.pop("drive")
+    given = {**drive, "force_n": args.force_n, "ramp_s": args.ramp_s}
+    return drives.complete(name, {k: v for k, v in given.items() if v is not None},
+                           lambda key: f"the drive needs {key}", duration_s=args.duration)
+
+
+#: The run options behind the names of :func:`workbench.model.simulate.check_settings`.
+RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--output-hz",
+                    "method": "--method", "tol": "--tol",
+                    "freq_hz": "--freq-hz", "f0_hz": "--chirp F0", "f1_hz": "--chirp F1",
+                    "width_s": "--pulse-s", "t_hit_s": "--hit-s", "ramp_s": "--ramp-s"}
+
+
+def _cmd_run(args) -> int:
+    from ..experiments import files
+    from ..experiments.matching import settings_of
+    from ..model import drives
+    from ..model.simulate import check_method, check_settings, simulate
+    n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse,
+                                           args.drive))
+    if n_drives > 1:
+        raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse, --drive")
+    if args.drive_set and args.drive is None:
+        raise ParameterError("--drive-set sets a --drive: give --drive KIND")
+    p = parameters_of(args)
+    names = dict(RUN_OPTION_NAMES)
+    drive = _run_drive(args)
+    if args.drive is not None:
+        names.update({key: f"--drive-set {key}" for key in drive if key != "drive"})
+    ex = drives.excitation_array(drive)
+    check_settings(p, ex, args.duration, args.dt, args.output_hz, names=names)
+    check_method(args.method, args.tol, dt_given=args.dt is not None, names=names)
+    if args.out:
+        check_output_file("--out", args.out, files.SUFFIXES)
+        meta = settings_of(drive, p)
+        files.check_settings(args.out, meta)
+    run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
+                   method=args.method, tol=args.tol, initial=args.initial, progress=not args.json and sys.stderr.isatty(),
+                   **drives.start_keywords(drive))
+    if args.out:
+        if files.format_of(args.out) == "parquet":       # the whole run: every signal, events
+            run.signals.attrs["meta"] = meta
+            run.to_parquet(args.out)
+        else:
+            files.write(args.out, files.record_from_run(run), meta)
+    summary = run.summary()
+    if args.json:
+        print(json_text(summary))
+    else:
+        for key, value in summary.items():
+            print(f"{key:>24}: {value}")
+    return EXIT_OK if run.ok else EXIT_RUN_FAILED
+
+
+def _cmd_params(args) -> int:
+    p = parameters_of(args)
+    rows = describe()
+    for row in rows:
+        row["value"] = getattr(p, row["name"])
+    if args.json:
+        print(json.dumps([{k: (str(v) if isinstance(v, float) and not math.isfinite(v) else v)
+                          for k, v in row.items()} for row in rows], default=str, indent=1))
+        return EXIT_OK
+    print(f"{'name':<11} {'value':>12} {'unit':<18} {'allowed':<16} source")
+    for r in rows:
+        flag = "  ASSUMPTION" if r["assumption"] else ""
+        value = "None" if r["value"] is None else (f"{r['value']:.6g}" if isinstance(r["value"], float)
+                                                  else str(r["value"]))
+        print(f"{r['name']:<11} {value:>12} {r['unit']:<18} {r['allowed']:<16} {r['source']}{flag}")
+    return EXIT_OK
+
+
+def add_parsers(sub) -> None:
+    """Add this module's sub-commands to the parser's ``sub``."""
+    from ..model import drives
+    modes = sub.add_parser("modes", help="natural frequencies of the linearised model")
+    add_model_options(modes)
+    modes.add_argument("--joint", choices=("locked", "free"), default="locked",
+                       help="locked: s = v = psi = 0; free: held only by the cork")
+    modes.add_argument("--json", action="store_true", help="print one JSON object")
+    modes.set_defaults(func=_cmd_modes)
+
+    run = sub.add_parser("run", help="simulate one run with contact (docs/model.md §7-9)")
+    add_model_options(run)
+    add_joint_options(run)
+    add_drive_options(run, ramp_help=f"soft-start ramp of sine/chirp (s); default "
+                                      f"{drives.DEFAULTS['ramp_s']:g} s, or half the run if shorter")
+    run.add_argument("--duration", type=number(0, MAX_DURATION_S, lo_open=True), default=1.0, help="simulated time (s)")
+    run.add_argument("--dt", type=number(MIN_DT, MAX_DT),
+                     help="fixed RK4 step (s; implies --method rk4 unless --tol is given); default "
+                     "from the model's fastest mode")
+    run.add_argument("--method", default=None,
+                     help="integration method: controlled (default: steps chosen by the error "
+                     "against --tol) or rk4 (fixed steps of --dt)")
+    run.add_argument("--tol", type=number(0, lo_open=True), default=None,
+                     help=f"relative tolerance of the controlled method (default {DEFAULT_TOL:g}; "
+                     "docs/model.md 'Integration')")
+    run.add_argument("--output-hz", type=number(0, MAX_OUTPUT_HZ, lo_open=True), default=1000.0, help="sample rate of the signals")
+    run.add_argument("--initial", choices=("static", "paper"), default="static",
+                     help="static equilibrium (default) or the paper's undeformed free start")
+    run.add_argument("--out", metavar="FILE", help="write the signals, in the format of the suffix: "
+                     ".parquet (every signal, and the events), .lvm, .txt, .tdms, .uff (Table 2)")
+    run.add_argument("--json", action="store_true", help="print one JSON object")
+    run.set_defaults(func=_cmd_run)
+
+    comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "
+                          "in parallel processes (make setup)")
+    comp.add_argument("--jobs", type=number(1, 256, integer=True), default=2,
+                      help="processes compiling at once (default 2)")
+    comp.set_defaults(func=_cmd_compile)
+
+    params = sub.add_parser("params", help="list every parameter with its unit, range and source")
+    add_model_options(params)
+    params.add_argument("--json", action="store_true", help="print JSON")
+    params.set_defaults(func=_cmd_params)

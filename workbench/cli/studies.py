@@ -1,0 +1,88 @@
+"""``workbench sweep`` and ``report``: a study's grid, in parallel and resumably
+(on joblib or a Dask cluster), and its figures, tables and report."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..model.params import ParameterError
+from ..study.paths import check_output_dir
+from .common import (EXIT_OK, EXIT_POINTS_FAILED, RESULTS, add_jobs_option, json_text)
+
+
+def _cmd_sweep(args) -> int:
+    from ..study.definition import load
+    from ..study.sweep import plan, run_study
+
+    study = load(args.study)
+    check_output_dir("--results", args.results)
+    if args.scheduler is not None:
+        _check_scheduler(args.scheduler)
+    if args.dry_run:
+        print(json_text(plan(study, args.results, fresh=args.fresh, jobs=args.jobs)))
+        return EXIT_OK
+    table = run_study(study, args.results, jobs=args.jobs, scheduler=args.scheduler,
+                      fresh=args.fresh, progress=not args.quiet)
+    counts = table.status.value_counts().to_dict() if len(table) else {}
+    summary = {"study": study.name, "points": study.n_points,
+               "status": {str(k): int(v) for k, v in counts.items()},
+               "results": str(Path(args.results) / study.name)}
+    if not args.no_report:
+        from ..present.report import make_report
+        summary["report"] = str(make_report(study, args.results, jobs=args.jobs))
+    print(json_text(summary))
+    return EXIT_OK if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
+
+
+def _check_scheduler(address: str) -> None:
+    """A Dask scheduler address tcp://HOST:PORT (or HOST:PORT) that accepts a connection."""
+    import socket
+    from urllib.parse import urlsplit
+    text = address if "://" in address else f"tcp://{address}"
+    try:
+        url = urlsplit(text)
+        scheme, host, port = url.scheme, url.hostname, url.port
+    except ValueError:
+        scheme, host, port = None, None, None
+    if scheme not in ("tcp", "tls") or not host or not port:
+        raise ParameterError(f"--scheduler {address}: expects a Dask scheduler address "
+                             "tcp://HOST:PORT")
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except OSError as exc:
+        raise ParameterError(f"--scheduler {address}: no scheduler answers there "
+                             f"({exc.strerror or exc}); start one with `dask scheduler`") from None
+
+
+def _cmd_report(args) -> int:
+    from ..present.report import make_report
+    from ..study.definition import load
+
+    study = load(args.study)
+    if not (Path(args.results) / study.name / "points.parquet").is_file():
+        raise ParameterError(f"report {args.study}: no results in {Path(args.results) / study.name}"
+                             f"; run `workbench sweep {args.study} --results {args.results}` first")
+    print(make_report(study, args.results, jobs=args.jobs))
+    return EXIT_OK
+
+
+def add_parsers(sub) -> None:
+    """Add this module's sub-commands to the parser's ``sub``."""
+    sweep = sub.add_parser("sweep", help="run a study's grid (TOML) in parallel, resumably")
+    sweep.add_argument("study", help="study definition, e.g. studies/default.toml")
+    add_jobs_option(sweep, "worker processes")
+    sweep.add_argument("--scheduler", default=None,
+                       help="Dask scheduler address (tcp://host:port): run on that cluster")
+    sweep.add_argument("--fresh", action="store_true", help="discard finished points first")
+    sweep.add_argument("--results", default=str(RESULTS), help="results root (default results/)")
+    sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.add_argument("--no-report", action="store_true",
+                       help="skip the figures, tables and report.md")
+    sweep.add_argument("--dry-run", action="store_true",
+                       help="check the study, print its grid size and expected cost, run nothing")
+    sweep.set_defaults(func=_cmd_sweep)
+
+    report = sub.add_parser("report", help="figures, tables and report.md of a study already run")
+    report.add_argument("study", help="study definition (TOML)")
+    report.add_argument("--results", default=str(RESULTS), help="results root (default results/)")
+    add_jobs_option(report, "processes drawing the figures")
+    report.set_defaults(func=_cmd_report)
