@@ -1,7 +1,8 @@
 """One place for numba options and numerical tolerances.
 
 Every kernel is compiled with :data:`JIT`; no module sets its own ``fastmath``
-or ``cache`` flags.  Tolerances used by more than one module live here too.
+or ``cache`` flags.  Every tolerance, margin and scale of the kernels lives
+here, each with what it bounds.
 """
 
 #: Options passed to every ``numba.njit`` in :mod:`workbench.core`.
@@ -104,3 +105,47 @@ REGIME_REL_TOL = 1e-9
 LAW_REL_TOL = 1e-9
 #: A pivot below this fraction of the largest entry is a dependent row.
 LAW_RANK_TOL = 1e-10
+#: A condition's slope along the null direction below this fraction of the sum
+#: of its terms' magnitudes is round-off: of the at most 4 products and of the
+#: elimination that gave the direction (about 4500 ulps).
+SLOPE_ROUND_OFF = 1e-12
+#: ... and a slope below this fraction of the condition's value is none.
+SLOPE_REL = 1e-13
+#: Lemke's result must satisfy the law to this fraction of the rates' and impulses' scales.
+LEMKE_CHECK_TOL = 1e-6
+#: A mode combination's reduced system is inconsistent when a dependent row's
+#: right side exceeds this fraction of the right sides' scale.
+CONSISTENCY_REL = 1e-8
+#: Of two solutions of the enumeration, the later replaces the earlier only if it
+#: loses more energy by this fraction of the largest impulse-rate product.
+ENERGY_TIE_REL = 1e-12
+#: After an impact a point leaves (is open) when its normal rate exceeds this
+#: fraction of the largest rate before it (cm/s over cm/s).
+OPEN_RATE_REL = 1e-7
+
+# --- constrained -------------------------------------------------------------
+#: The constrained accelerations' elimination sets an unknown to 0 when its pivot
+#: is below this fraction of the largest entry (a row zero on the free
+#: coordinates, or dependent on the others).
+PIVOT_REL = 1e-12
+#: Two contacts' 3 x 4 rows have no common null direction when every 3 x 3
+#: cofactor is below this times the cube of the rows' scale.
+NULL_COFACTOR_REL = 1e-12
+
+# --- controlled --------------------------------------------------------------
+#: An accepted interval whose estimate is below COARSEN_MARGIN / 2^p (p the
+#: order) lets the next one try a level coarser (a level divides the error by 2^p).
+COARSEN_MARGIN = 0.5
+#: Floors of the error scales: the clearance (cm) for positions (over a
+#: length for angles), and that times REF_RATE (1/s) for velocities.
+REF_RATE = 100.0
+
+# --- equilibrium (the static start) --------------------------------------------
+#: Scales of the Newton residual's rows: forces (dyn) and gaps (cm).
+FORCE_SCALE = 1e5
+GAP_SCALE = 1e-3
+#: Relative central-difference steps of the Jacobian: coordinates, forces.
+FD_COORD = 1e-7
+FD_FORCE = 1e-3
+#: The line search halves alpha down to this, then takes the last alpha tried.
+ALPHA_MIN = 1e-4

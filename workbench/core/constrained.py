@@ -34,7 +34,7 @@ their rates onto the active rows.
 import numba as nb
 import numpy as np
 
-from .config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS
+from .config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, NULL_COFACTOR_REL, PIVOT_REL
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
 from .dynamics import rhs, solve_factored
@@ -105,14 +105,14 @@ def small_solve(cw, m):
     """Solve D x = c (m <= MAX_ROWS) held in rows CW_D.. of cw; x into column CW_L_COL.
 
     Gaussian elimination with partial pivoting.  An unknown whose pivot is
-    negligible (below 1e-12 of the largest entry: a row that is zero on the
+    negligible (below PIVOT_REL of the largest entry: a row that is zero on the
     free coordinates or dependent on the others) is set to 0.
     """
     scale = 0.0
     for i in range(m):
         for j in range(m):
             scale = max(scale, abs(cw[ly.CW_D + i, j]))
-    tiny = 1e-12 * scale
+    tiny = PIVOT_REL * scale
     for col in range(m):
         piv = col
         for r in range(col + 1, m):
@@ -298,7 +298,7 @@ def stick_margin(P, free, cg, rg):
     scale = 1.0
     for r in (n1, t1, n2, t2):
         scale = max(scale, abs(r[0]) + abs(r[1]) + abs(r[2]))
-    if big <= 1e-12 * scale ** 3:
+    if big <= NULL_COFACTOR_REL * scale ** 3:
         return shared
     d0 /= big
     d1 /= big

@@ -37,17 +37,11 @@ Every decision depends on the state only, so a run is deterministic.
 import numba as nb
 import numpy as np
 
-from .config import JIT, JIT_INLINE, MAX_EVENTS_PER_STEP
+from .config import COARSEN_MARGIN, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP, REF_RATE
 from . import layout as ly
 from .contact import regime_of
 from .hybrid import _store, advance, begin
 
-#: An accepted interval whose estimate is below COARSEN_MARGIN / 2^p (p the
-#: order) lets the next one try a level coarser (a level divides the error by 2^p).
-COARSEN_MARGIN = 0.5
-#: Floors of the error scales: the clearance (cm) for positions (over a
-#: length for angles), and that times REF_RATE (1/s) for velocities.
-REF_RATE = 100.0
 #: Returned for two paths whose event sequences differ (no estimate).
 MISMATCH = 1e300
 

@@ -24,21 +24,11 @@ gaps, friction, least potential energy) is decided by
 import numba as nb
 import numpy as np
 
-from .config import JIT, JIT_ALLOC, JIT_INLINE
+from .config import ALPHA_MIN, FD_COORD, FD_FORCE, FORCE_SCALE, GAP_SCALE, JIT, JIT_ALLOC, JIT_INLINE
 from . import layout as ly
 from .contact import fill_geometry
 from .dynamics import add_applied_forces, assemble_inertia, cork_energy
 from .kinematics import element, n_elements
-
-#: Scales of the residual's rows: forces (dyn) and gaps (cm).
-FORCE_SCALE = 1e5
-GAP_SCALE = 1e-3
-#: Relative central-difference steps of the Jacobian: coordinates, forces.
-FD_COORD = 1e-7
-FD_FORCE = 1e-3
-#: The line search halves alpha down to this, then takes the last alpha tried.
-ALPHA_MIN = 1e-4
-
 
 @nb.njit(**JIT)
 def _residual(z, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat, vec, cg,

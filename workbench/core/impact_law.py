@@ -31,16 +31,11 @@ import math
 import numba as nb
 import numpy as np
 
-from .config import JIT, JIT_INLINE, LAW_RANK_TOL, LAW_REL_TOL
+from .config import (CONSISTENCY_REL, ENERGY_TIE_REL, JIT, JIT_INLINE, LAW_RANK_TOL, LAW_REL_TOL,
+                     LEMKE_CHECK_TOL, OPEN_RATE_REL, SLOPE_REL, SLOPE_ROUND_OFF)
 from . import layout as ly
 
 OPEN, STICK, SLIP_POS, SLIP_NEG = 0, 1, 2, 3
-#: A condition's slope along the null direction below this fraction of the sum
-#: of its terms' magnitudes is round-off: of the at most 4 products and of the
-#: elimination that gave the direction (about 4500 ulps).
-SLOPE_ROUND_OFF = 1e-12
-#: Lemke's result must satisfy the law to this fraction of the rates' and impulses' scales.
-LEMKE_CHECK_TOL = 1e-6
 #: Solution sources returned by :func:`solve_impact`.
 FOUND_ENUMERATION, FOUND_LEMKE, NOT_FOUND = 1, 2, 0
 
@@ -184,7 +179,7 @@ def _clip(c, d, d_abs, lo, hi):
     would be an arbitrary bound).
     """
     scale = abs(c) + 1e-300
-    if abs(d) <= 1e-13 * scale or abs(d) <= SLOPE_ROUND_OFF * d_abs:
+    if abs(d) <= SLOPE_REL * scale or abs(d) <= SLOPE_ROUND_OFF * d_abs:
         if c < 0.0:
             return 1.0, -1.0
         return lo, hi
@@ -251,7 +246,7 @@ def _solve_with_null(A, k, z0, dz, piv_row, g_max):
     for i in range(k):
         rhs_scale = max(rhs_scale, abs(A[i, k]))
     for i in range(rank, k):
-        if abs(A[i, k]) > 1e-8 * rhs_scale + 1e-300:
+        if abs(A[i, k]) > CONSISTENCY_REL * rhs_scale + 1e-300:
             return False         # inconsistent
     # particular solution (free unknown 0) and the null direction (free unknown 1)
     for which in range(2):
@@ -311,7 +306,7 @@ def solve_impact(G, u, mu, m, lw, P, modes):
         scale = 0.0
         for r in range(2 * m):
             scale = max(scale, abs(trial[r] * u[r]))
-        if not found or de < best_de - 1e-12 * scale:
+        if not found or de < best_de - ENERGY_TIE_REL * scale:
             found = True
             best_de = de
             for r in range(2 * m):
@@ -350,7 +345,7 @@ def classify(G, u, P, m, modes):
     u_scale = 0.0
     for r in range(2 * m):
         u_scale = max(u_scale, abs(u[r]))
-    tol = 1e-7 * u_scale + 1e-300
+    tol = OPEN_RATE_REL * u_scale + 1e-300
     for i in range(m):
         un, ut = _post_rates(G, u, P, m, i)
         if un > tol:
