@@ -49,7 +49,7 @@ $(RESULTS)/%/report.md: studies/%.toml $(SOURCES) $(STAMP)
 
 # The paper's operating range driven hard (MODEL.md §5-§7): not part of `make study`.
 STRESS := stress stress_paper stress_chirp
-stress: $(foreach s,$(STRESS),$(RESULTS)/$(s)/report.md)  ## the stress studies: every gap, 10-55 Hz, 20-200 N, chirps (about 30 min)
+stress: $(foreach s,$(STRESS),$(RESULTS)/$(s)/report.md)  ## the stress studies: every gap, 10-55 Hz, 20-200 N, chirps (hours: `workbench sweep STUDY --dry-run` estimates each)
 	$(PY) studies/stress_check.py $(RESULTS) $(STRESS)
 
 $(RESULTS)/modes/modes.md: $(STAMP) studies/modes.py $(SOURCES)
