@@ -110,7 +110,7 @@ CASES = [
     (["run", "--set", "nonsense=1"], ["--set nonsense=1", "unknown parameter"]),
     (["run", "--set", "gap_mm"], ["--set", "NAME=VALUE"]),
     (["run", "--output-hz", "333"], ["--output-hz", "333"]),
-    (["run", "--free-decay", "1e9"], ["--free-decay", "1e9"]),
+    (["run", "--free-decay", "1e9"], ["--free-decay = 1000000000.0 cm", "allowed range"]),
     (["run", "--out", "missing/dir/run.parquet"], ["--out", "missing/dir"]),
     (["run", "--out", "."], ["--out", "folder"]),
     (["run", "--out", "run.csv"], ["--out", ".parquet"]),

@@ -70,7 +70,8 @@ def _run_drive(args) -> dict:
 RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--output-hz",
                     "method": "--method", "tol": "--tol",
                     "freq_hz": "--freq-hz", "f0_hz": "--chirp F0", "f1_hz": "--chirp F1",
-                    "width_s": "--pulse-s", "t_hit_s": "--hit-s", "ramp_s": "--ramp-s"}
+                    "width_s": "--pulse-s", "t_hit_s": "--hit-s", "ramp_s": "--ramp-s",
+                    "deflection_cm": "--free-decay"}
 
 
 def _cmd_run(args) -> int:
@@ -90,6 +91,7 @@ def _cmd_run(args) -> int:
     if args.drive is not None:
         names.update({key: f"--drive-set {key}" for key in drive if key != "drive"})
     ex = drives.excitation_array(drive)
+    start = drives.start_keywords(drive, names)
     check_settings(p, ex, args.duration, args.dt, args.output_hz, names=names)
     check_method(args.method, args.tol, dt_given=args.dt is not None, names=names)
     if args.out:
@@ -98,7 +100,7 @@ def _cmd_run(args) -> int:
         files.check_settings(args.out, meta)
     run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
                    method=args.method, tol=args.tol, initial=args.initial, progress=not args.json and sys.stderr.isatty(),
-                   **drives.start_keywords(drive))
+                   **start)
     if args.out:
         if files.format_of(args.out) == "parquet":       # the whole run: every signal, events
             run.signals.attrs["meta"] = meta

@@ -22,7 +22,7 @@ from typing import Callable
 import numpy as np
 
 from ..core import excitation as cx
-from .limits import MIN_PULSE_STEPS, PULSE_STEPS, STEPS_PER_PERIOD
+from .limits import FREE_DECAY_MAX_CM, MIN_PULSE_STEPS, PULSE_STEPS, STEPS_PER_PERIOD
 from .params import ParameterError, check_positive
 
 #: dyn per newton
@@ -160,6 +160,16 @@ def _pulse_dt(ex) -> float:
     return ex[cx.X_WIDTH] / PULSE_STEPS
 
 
+def _release(settings, name) -> dict:
+    """A free decay's start: the tip's static deflection (cm), within FREE_DECAY_MAX_CM."""
+    x = settings["deflection_cm"]
+    if (isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x)
+            or abs(x) > FREE_DECAY_MAX_CM):
+        raise ParameterError(f"{name('deflection_cm')} = {x!r} cm is outside the allowed range "
+                             f"[-{FREE_DECAY_MAX_CM:g}, {FREE_DECAY_MAX_CM:g}] cm")
+    return {"free_decay_cm": float(x)}
+
+
 # --- the registry ------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -175,7 +185,7 @@ class Drive:
     ramped: bool = False                           # a soft start (ramp_s), dropped inside a stepped chain
     frequency_key: str | None = None               # the setting that is the forcing frequency
     swept: bool = False                            # the frequency sweeps over the run (chirp figures)
-    start: Callable[[dict], dict] = field(default=lambda settings: {})   # simulate() keywords
+    start: Callable[[dict, Callable], dict] = field(default=lambda settings, name: {})  # simulate() keywords
     defaults: dict = field(default_factory=dict)   # its own defaults, before DEFAULTS
 
     def default(self, key: str, duration_s: float | None = None):
@@ -247,9 +257,11 @@ def excitation_array(settings: dict, first_in_chain: bool = True) -> np.ndarray:
     return drive.build(e)
 
 
-def start_keywords(settings: dict) -> dict:
-    """The keywords of :func:`~workbench.model.simulate.simulate` that set the drive's start."""
-    return get(settings["drive"]).start(settings)
+def start_keywords(settings: dict, names: dict | None = None) -> dict:
+    """The keywords of :func:`~workbench.model.simulate.simulate` that set the drive's start,
+    checked (a ParameterError names a setting as ``names`` maps it: an option, a study key)."""
+    names = names or {}
+    return get(settings["drive"]).start(settings, lambda key: names.get(key, key))
 
 
 def band_hz(settings: dict) -> tuple[float, float] | None:
@@ -271,7 +283,7 @@ register(Drive("sine", ("force_n", "freq_hz", "ramp_s"), lambda e: sine(**e),
 register(Drive("chirp", ("force_n", "f0_hz", "f1_hz", "sweep_s", "ramp_s"), lambda e: chirp(**e),
                code=cx.EXC_CHIRP, check=_check_chirp, ramped=True, swept=True))
 register(Drive("free_decay", ("deflection_cm",), lambda e: none(),
-               start=lambda e: {"free_decay_cm": e["deflection_cm"]}))
+               start=_release))
 register(Drive("hammer_joint", ("force_n", "width_s", "t_hit_s"), lambda e: hammer_joint(**e),
                code=cx.EXC_HAMMER_JOINT, check=_check_pulse, dt_max=_pulse_dt,
                defaults={"force_n": DEFAULT_HAMMER_N}))

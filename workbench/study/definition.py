@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..model import drives
-from ..model.limits import FREE_DECAY_MAX_CM, MAX_NAME_CHARS
+from ..model.limits import MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 SWEEP_MODES = ("independent", "up", "down", "up-down")
@@ -295,12 +295,7 @@ def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     """A point's excitation values, and its run settings against what the step resolves."""
     from ..model.simulate import check_settings
     ex = point.excitation_array()                  # validates the excitation values
-    if point.excitation["drive"] == "free_decay":
-        x = point.excitation.get("deflection_cm")
-        ok = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-        if not ok or abs(x) > FREE_DECAY_MAX_CM:
-            raise StudyError(f"{where['deflection_cm']} = {_short(x)} cm is outside the allowed "
-                             f"range [-{FREE_DECAY_MAX_CM:g}, {FREE_DECAY_MAX_CM:g}] cm")
+    drives.start_keywords(point.excitation, where)
     check_settings(point.params, ex, duration, dt, output_hz, names=where)
 
 
