@@ -26,7 +26,7 @@ setup: $(STAMP)  ## create .venv, install the package (editable) with dev extras
 test: $(STAMP)  ## run the test suite (physics checks included)
 	$(PY) -m pytest -q
 
-# About 16 minutes idle, 21 beside other work: a cold compile (6-10), `make study` (5-7), LSODA on windows, the default grid twice (1 s per point).
+# About 65 minutes: a cold compile (1.5), `make study` whole (44), LSODA on windows, the default grid twice (1 s per point).
 bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md and README.md
 	$(PY) -m pytest -q benchmarks --benchmark-only --benchmark-enable --benchmark-autosave \
 		--benchmark-columns=min,median,max,rounds -p no:randomly
