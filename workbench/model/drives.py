@@ -233,12 +233,10 @@ def complete(name: str, given: dict, needs: Callable[[str], str], where: str = "
     drive = get(name, where)
     settings = {"drive": drive.name}
     for key in drive.keys:
-        if key in given:
-            settings[key] = given[key]
-        elif drive.default(key) is not None:
-            settings[key] = drive.default(key, duration_s)
-        else:
+        value = given[key] if key in given else drive.default(key, duration_s)
+        if value is None:
             raise ParameterError(needs(key))
+        settings[key] = value
     return settings
 
 
