@@ -12,7 +12,10 @@ the event log, ``regimes.contact_shares_of``), and the events in the
 window.  Methods: fixed RK4 at the default step, at a half and a quarter of
 it, and the controlled method at each tolerance, with its wall time, its
 lattice steps (accepted and in all) and its own largest error estimate.
-``table`` prints the saved results as Markdown.
+``table`` prints the saved results as Markdown, and for each tolerance the
+ratio of the run's global error estimate to its measured error (the larger
+of the tip's and the shares') over the cases whose converged solution is
+converged (its own error below 1e-4 of the tip's range).
 """
 from __future__ import annotations
 
@@ -108,7 +111,8 @@ def measure(name, params, ex, tols):
         rows.append({"case": name, "method": f"controlled {tol:g}", "ok": run.ok,
                      "wall_s": run.wall_s, "steps": c["steps"], "steps_all": c["steps_all"],
                      "rejected": c["rejected"], "h_min": c["h_min"],
-                     "error_est_max": c["error_est_max"], "floor_count": c["floor_count"],
+                     "error_est_max": c["error_est_max"], "global_error_est": c["global_error_est"],
+                     "floor_count": c["floor_count"],
                      **compare(run, ref)})
     return rows
 
@@ -145,7 +149,24 @@ def main(argv=None):
               f"{r['events']} ({r['events_ref']}) | {r.get('wall_s', 0):.2f} | {r['steps']} "
               f"({r.get('steps_all', r['steps'])}) | {r.get('error_est_max') or 0:.1e} | "
               f"{r.get('floor_count', '')} |")
+    honesty(rows)
     return 0
+
+
+def honesty(rows) -> None:
+    """The global estimate over the measured error, per tolerance: range, median, outside 0.1-10."""
+    converged = {r["case"] for r in rows if r["method"] == "reference" and r["ref_tip_err"] < 1e-4}
+    ratios = {}
+    for r in rows:
+        measured = max(r.get("tip_err", 0.0), r.get("share_err", 0.0))
+        if r["case"] in converged and r.get("global_error_est") is not None and measured > 0:
+            ratios.setdefault(r["method"], []).append(r["global_error_est"] / measured)
+    print("\n| method | cases | estimate / measured: min | median | max | outside 0.1-10 |")
+    print("|---|---|---|---|---|---|")
+    for method, v in ratios.items():
+        v = np.array(v)
+        print(f"| {method} | {len(v)} | {v.min():.2f} | {np.median(v):.2f} | {v.max():.2f} | "
+              f"{int(((v < 0.1) | (v > 10)).sum())} |")
 
 
 if __name__ == "__main__":

@@ -184,6 +184,31 @@ def interval_error(tol, span, a, n_coarse, b, n_fine, P, stages, ev, log, snap, 
     return err / (2.0 ** P[ly.P_RK_ORDER] - 1.0), arg     # Richardson's factor
 
 
+@nb.njit(**JIT)
+def accumulate_local(a, b, n, P, stages, log, snap, scale, ctl):
+    """Add an accepted interval's local estimates to the run's sums of squares.
+
+    The fine path is at STAGE_CUR and the coarse one in snap; the n events
+    of both are log rows [a, a + n) and [b, b + n).  Adds the square of the
+    largest relative error of a position (Richardson's estimate over the
+    scale of :func:`interval_error`) to ctl[CTL_Q_SSQ], and the squares of
+    the events' time errors (s) to ctl[CTL_T_SSQ].  Their roots estimate the
+    run's global error as local errors of random sign would add up.
+    """
+    richardson = 2.0 ** P[ly.P_RK_ORDER] - 1.0
+    y = stages[ly.STAGE_CUR]
+    q = 0.0
+    for i in range(ly.N_DOF):
+        s = max(scale[ly.SCALE_FLOOR, i], scale[ly.SCALE_PEAK, i],
+                scale[ly.SCALE_PEAK, PARTNER[i]], abs(y[i]))
+        q = max(q, abs(y[i] - snap[ly.SNAP_COARSE + ly.SNAP_Y, i]) / s)
+    q /= richardson
+    ctl[ly.CTL_Q_SSQ] += q * q
+    for i in range(n):
+        e = abs(log[a + i, ly.LOG_T] - log[b + i, ly.LOG_T]) / richardson
+        ctl[ly.CTL_T_SSQ] += e * e
+
+
 @nb.njit(**JIT_INLINE)
 def _move_rows(log, src, n, dst):
     if src != dst:
@@ -256,6 +281,10 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
             if status == ly.OK and coarse_ok and not _took_stepped(st, snap):
                 err, arg = interval_error(tol, seg * dt, n_log, end_c - n_log, end_c,
                                           end_f - end_c, P, stages, ev, log, snap, scale, ctl)
+                if err <= 1.0 or k + 1 >= level_max:
+                    if err < MISMATCH:
+                        accumulate_local(n_log, end_c, end_f - end_c, P, stages, log, snap,
+                                         scale, ctl)
             _move_rows(log, end_c, end_f - end_c, n_log)
             end_f = n_log + end_f - end_c
             if err <= 1.0 or k + 1 >= level_max:

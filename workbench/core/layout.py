@@ -316,7 +316,12 @@ CTL_ARG_ERR_MAX = 11     # what set CTL_ERR_MAX: a component of (q, q'), or N_ST
 CTL_REJECTED_EVENTS = 12  # rejections because the two paths' event sequences differed
 CTL_LEVELS = 13      # CTL_LEVELS + j: intervals accepted with fine steps dt / 2^j (j < N_CTL_LEVELS)
 N_CTL_LEVELS = 10
-N_CTL = CTL_LEVELS + N_CTL_LEVELS
+# Sums of squares of the accepted intervals' local estimates (Richardson's,
+# not over the tolerance): the largest relative error of a position q_i (over
+# its scale) per interval, and each event's time error (s).
+CTL_Q_SSQ = CTL_LEVELS + N_CTL_LEVELS
+CTL_T_SSQ = CTL_Q_SSQ + 1
+N_CTL = CTL_Q_SSQ + 2
 # Error scales scale (2, N_STATE): row SCALE_FLOOR the smallest scale of each
 # component of (q, q'), row SCALE_PEAK its largest |value| so far.
 SCALE_FLOOR, SCALE_PEAK = 0, 1

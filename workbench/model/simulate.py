@@ -499,7 +499,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     run.compile_s = compile_s
     run.method = method
     run.tol = tol
-    run.control = (control_summary(controller[1], controller[3], tol, dt) if controller
+    run.control = (control_summary(controller[1], controller[3], tol, dt, duration) if controller
                    else fixed_step_summary(dt, int(st[ly.ST_STEP])))
     return run
 
@@ -530,11 +530,19 @@ def check_method(method: str | None, tol: float | None, dt_given: bool = False,
     return method, float(tol)
 
 
-def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: float) -> dict:
-    """The controlled run's steps, rejections and error estimate (Run.summary keys).
+def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: float,
+                    duration: float) -> dict:
+    """The controlled run's steps, rejections and error estimates (Run.summary keys).
 
     ``intervals_by_step`` counts the control intervals accepted at each
-    step (s) of the lattice of base step dt.
+    step (s) of the lattice of base step dt.  Besides the largest local
+    estimate, the run's global error is estimated as the root sum of
+    squares of the accepted intervals' local estimates (local errors of
+    random sign): ``q_error_rss`` for the positions (relative to their
+    scales, as the tip's error relative to its range) and
+    ``share_error_rss`` for the contact codes' time shares (the events'
+    time errors over the run's ``duration`` (s)); ``global_error_est`` is
+    the larger (docs/model.md, "How far to trust it").
     """
     n_floor = int(ctl[ly.CTL_N_FLOOR])
     floors = [{"t0": float(r[ly.FL_T0]), "t1": float(r[ly.FL_T1]),
@@ -546,7 +554,10 @@ def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: floa
     done = ctl[ly.CTL_INTERVALS] > 0
     names = [*Q_COLUMNS, *QD_COLUMNS, *ly.EV_NAMES, "event_time"]
     arg = int(ctl[ly.CTL_ARG_ERR_MAX])
-    levels = {f"{dt / 2 ** j:.4g}": int(n) for j, n in enumerate(ctl[ly.CTL_LEVELS:]) if n > 0}
+    q_rss = float(np.sqrt(ctl[ly.CTL_Q_SSQ]))
+    share_rss = float(np.sqrt(ctl[ly.CTL_T_SSQ])) / duration if duration > 0 else 0.0
+    per_level = ctl[ly.CTL_LEVELS:ly.CTL_LEVELS + ly.N_CTL_LEVELS]
+    levels = {f"{dt / 2 ** j:.4g}": int(n) for j, n in enumerate(per_level) if n > 0}
     return {"steps": int(ctl[ly.CTL_STEPS]), "steps_all": int(ctl[ly.CTL_WORK]),
             "intervals": int(ctl[ly.CTL_INTERVALS]), "rejected": int(ctl[ly.CTL_REJECTED]),
             "h_min": float(ctl[ly.CTL_H_MIN]) if done else None,
@@ -557,6 +568,8 @@ def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: floa
             "error_max_in": names[arg] if done else None,
             "rejected_by_events": int(ctl[ly.CTL_REJECTED_EVENTS]),
             "intervals_by_step": levels,
+            "global_error_est": max(q_rss, share_rss), "q_error_rss": q_rss,
+            "share_error_rss": share_rss,
             "floor_count": n_floor, "floor_intervals": floors}
 
 
@@ -565,6 +578,7 @@ def fixed_step_summary(dt: float, steps: int) -> dict:
     return {"steps": steps, "steps_all": steps, "intervals": steps, "rejected": 0,
             "h_min": dt, "h_max": dt, "error_est_max": None, "error_over_tol_max": None,
             "t_error_max": None, "error_max_in": None, "rejected_by_events": 0,
+            "global_error_est": None, "q_error_rss": None, "share_error_rss": None,
             "intervals_by_step": {f"{dt:.4g}": steps}, "floor_count": 0, "floor_intervals": []}
 
 

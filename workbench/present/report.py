@@ -191,6 +191,11 @@ def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
     lines = [f"Integration: {study.method}, tol = {study.tol:g}; the largest error estimate is "
              f"{worst.error_over_tol_max:.3g} of the tolerance ({point_title(worst)}); steps "
              f"{ok.h_min.min():.3g}-{ok.h_max.max():.3g} s.", ""]
+    if "global_error_est" in ok and ok.global_error_est.notna().any():
+        g = ok.loc[ok.global_error_est.idxmax()]
+        lines[0] += (f" The largest global error estimate (the local estimates' root sum of "
+                     f"squares, of a position's scale or a contact share) is "
+                     f"{g.global_error_est:.2g} ({point_title(g)}).")
     over = ok[(ok.error_over_tol_max > 1.0) | (ok.floor_count > 0)]
     if len(over):
         lines += ["## Points above their tolerance", "",

@@ -46,7 +46,7 @@ WATCHDOG_S = 1.0
 STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
 #: The integrator's account kept in a point's row (Run.summary keys).
 CONTROL_KEYS = ("steps", "steps_all", "rejected", "h_min", "h_max", "error_est_max",
-                "error_over_tol_max", "floor_count")
+                "error_over_tol_max", "global_error_est", "floor_count")
 
 
 def point_key(study: Study, point: Point, previous_key: str = "") -> str:
