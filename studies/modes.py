@@ -1,5 +1,6 @@
-"""Modal table of the model: natural frequencies for tip mass on/off, joint
-locked/free and every cork model, linearised about the undeformed state.
+"""Modal table of the model: natural frequencies and damping ratios for tip
+mass on/off, joint locked/free and every cork model, linearised about the
+undeformed state.
 
 Writes ``modes.csv``, ``modes.md`` and ``provenance.json`` into ``--out``;
 part of ``make study``.
@@ -13,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from workbench.model.modes import natural_frequencies
+from workbench.model.modes import damping_ratios
 from workbench.model.params import CORK_MODELS, Parameters
 from workbench.study.provenance import environment
 
@@ -26,14 +27,26 @@ def table() -> pd.DataFrame:
         for joint in ("locked", "free"):
             for cork in (CORK_MODELS if joint == "free" else ["cubic"]):
                 p = Parameters(tip_mass=tip, cork=cork)
-                f = natural_frequencies(p, joint)
+                f, zeta = damping_ratios(p, joint)
                 rigid = int((f == 0.0).sum())
-                elastic = f[f > 0.0][:N_MODES]
                 row = {"tip_mass": "on" if tip else "off", "joint": joint,
                        "cork": cork if joint == "free" else "-", "rigid_modes": rigid}
-                row.update({f"f{i + 1}_hz": v for i, v in enumerate(elastic)})
+                for i, (fi, zi) in enumerate(zip(f[f > 0.0][:N_MODES], zeta[f > 0.0][:N_MODES])):
+                    row[f"f{i + 1}_hz"] = fi
+                    row[f"zeta{i + 1}"] = zi
                 rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _markdown(df: pd.DataFrame) -> str:
+    """Frequencies with 3 decimals, damping ratios with 4 significant digits."""
+    out = df.copy()
+    for col in out.columns:
+        if col.startswith("f") and col.endswith("_hz"):
+            out[col] = out[col].map(lambda v: f"{v:.3f}")
+        elif col.startswith("zeta"):
+            out[col] = out[col].map(lambda v: f"{v:.4g}")
+    return out.to_markdown(index=False)
 
 
 def main() -> None:
@@ -43,14 +56,16 @@ def main() -> None:
     start = time.perf_counter()
     df = table()
     args.out.mkdir(parents=True, exist_ok=True)
-    df.to_csv(args.out / "modes.csv", index=False, float_format="%.4f")
-    note = ("Natural frequencies (Hz) of the 9-DOF model linearised about the undeformed "
+    df.to_csv(args.out / "modes.csv", index=False, float_format="%.6g")
+    note = ("Natural frequencies (Hz) and damping ratios (zeta: -Re/|lambda| of the damped "
+            "linear system's eigenvalue, the beams' structural damping and the cork's damper) "
+            "of the 9-DOF model linearised about the undeformed "
             "state (gravity's geometric stiffness omitted). Joint 'locked' holds s = v = psi = 0; "
             "'free' leaves them to the cork, whose tangent stiffness at s = 0 is zero for the "
             "quadratic and cubic models: those coordinates are rigid-body modes (counted in "
             "rigid_modes, 0 Hz) and the elastic frequencies follow.\n\n")
     (args.out / "modes.md").write_text("# Modal table\n\n" + note
-                                       + df.to_markdown(index=False, floatfmt=".3f") + "\n")
+                                       + _markdown(df) + "\n")
     provenance = {**environment(), "study": "modes", "wall_s": time.perf_counter() - start,
                   "parameters": Parameters().to_dict()}
     (args.out / "provenance.json").write_text(json.dumps(provenance, indent=1, default=str))

@@ -75,3 +75,36 @@ def test_cli_reports_bad_input(capsys):
     assert "gap_mm = 9 mm is outside the allowed range (0, 5] mm" in capsys.readouterr().err
     assert main(["modes", "--cork", "cubic", "--set", "m3=nan"]) == 2
     assert "m3 must be finite" in capsys.readouterr().err
+
+
+def test_stiffness_proportional_damping_gives_its_closed_form_ratios():
+    """With both beams' bending blocks at one beta (C_b = beta K_b) and no cork damper, the
+    locked bending modes are classically damped: zeta_i = beta omega_i / 2 (Chopra, Dynamics
+    of Structures, 4th ed., §11.4.1, stiffness-proportional damping)."""
+    from workbench.model.modes import damping_ratios
+    p = Parameters()
+    beta = p.damping_beta("a")
+    q = p.replace(zeta_b=p.zeta_b * beta / p.damping_beta("b"), cork_c=0.0)
+    assert q.damping_beta("b") == pytest.approx(beta, rel=1e-12)
+    f, zeta = damping_ratios(q, "locked")
+    bending = f < 500.0       # the axial modes (about 1 kHz and above) have their own zeta
+    assert bending.sum() == 4
+    assert zeta[bending] == pytest.approx(beta * np.pi * f[bending], rel=1e-6)
+
+
+def test_damping_ratios_rise_with_the_cork_damper_and_rigid_modes_have_none():
+    from workbench.model.modes import damping_ratios
+    f, zeta = damping_ratios(Parameters(cork="linear"), "free")
+    f2, zeta2 = damping_ratios(Parameters(cork="linear", cork_c=2 * Parameters(cork="linear").cork_law.c), "free")
+    assert np.array_equal(f, f2)
+    assert np.isnan(zeta[f == 0.0]).all() and np.isfinite(zeta[f > 0.0]).all()
+    cork_mode = int(np.nanargmax(zeta))          # the loose body on the cork's spring and damper
+    assert zeta2[cork_mode] > 1.5 * zeta[cork_mode]
+    assert np.all((zeta > 0.0) | np.isnan(zeta))
+
+
+def test_cli_modes_prints_the_damping_ratios(capsys):
+    assert main(["modes", "--tip-mass", "on", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["damping_ratios"]) == len(out["frequencies_hz"])
+    assert out["damping_ratios"][1] == pytest.approx(0.00437, rel=1e-2)   # mode 2, 13.9 Hz

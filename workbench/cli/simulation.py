@@ -7,6 +7,8 @@ import math
 import sys
 import time
 
+import numpy as np
+
 from ..model.limits import DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_OUTPUT_HZ, MIN_DT
 from ..model.params import ParameterError, describe
 from ..study.paths import check_output_file
@@ -16,17 +18,19 @@ from .common import (EXIT_INTERNAL, EXIT_OK, EXIT_RUN_FAILED, add_drive_options,
 
 
 def _cmd_modes(args) -> int:
-    from ..model.modes import natural_frequencies
+    from ..model.modes import damping_ratios
     p = parameters_of(args)
-    freqs = natural_frequencies(p, args.joint)
+    freqs, zeta = damping_ratios(p, args.joint)
     if args.json:
-        print(json_text({"frequencies_hz": [float(f) for f in freqs], "joint": args.joint,
-                          "tip_mass": p.tip_mass, "cork": p.cork}))
+        print(json_text({"frequencies_hz": [float(f) for f in freqs],
+                         "damping_ratios": [None if np.isnan(z) else float(z) for z in zeta],
+                         "joint": args.joint, "tip_mass": p.tip_mass, "cork": p.cork}))
     else:
-        print(f"Natural frequencies, joint {args.joint}, tip mass {'on' if p.tip_mass else 'off'}, "
-              f"cork {p.cork} (linearised about the undeformed state):")
-        for i, f in enumerate(freqs, 1):
-            print(f"  mode {i}: {f:12.4f} Hz")
+        print(f"Natural frequencies and damping ratios, joint {args.joint}, tip mass "
+              f"{'on' if p.tip_mass else 'off'}, cork {p.cork} (linearised about the undeformed "
+              "state; a rigid-body mode has no damping ratio):")
+        for i, (f, z) in enumerate(zip(freqs, zeta), 1):
+            print(f"  mode {i}: {f:12.4f} Hz  zeta " + ("   -" if np.isnan(z) else f"{z:.5f}"))
     return EXIT_OK
 
 

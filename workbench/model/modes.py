@@ -81,6 +81,61 @@ def _check_conditioned(M, K, joint) -> None:
                              "a mass or length is out of scale")
 
 
+def linear_damping(p: Parameters, joint: str = "locked") -> np.ndarray:
+    """The damping matrix C (dyn s/cm and kin) on the moving coordinates: the beams' and the
+    cork's dampers (docs/model.md §5-6), in the order of :func:`linear_matrices`."""
+    model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
+    C = model.kc[ly.KC_C][np.ix_(model.free, model.free)].copy()
+    if ly.S in model.free:
+        i = list(model.free).index(ly.S)
+        C[i, i] += p.cork_law.c
+    return C
+
+
+def _state_matrix(p: Parameters, joint: str) -> np.ndarray:
+    M, K, _ = linear_matrices(p, joint)
+    C = linear_damping(p, joint)
+    _check_conditioned(M, K, joint)
+    n = len(M)
+    Minv = np.linalg.inv(M)
+    return np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+
+
+#: A damped eigenvalue belongs to an undamped mode when their |lambda| differ by at most this.
+MODE_MATCH_REL = 0.05
+
+
+def damping_ratios(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray]:
+    """Natural frequencies (Hz, as :func:`natural_frequencies`) and each mode's damping ratio.
+
+    The ratio of mode i is -Re(lambda) / |lambda| of the damped system's eigenvalue
+    (upper half plane, not taken by a lower mode) nearest to its omega_i (within
+    MODE_MATCH_REL), the exact modal
+    damping of the linearised model even where the cork's damper makes the damping
+    non-proportional; a mode with no such eigenvalue (overdamped) takes the projection
+    phi_i^T C phi_i / (2 omega_i) of its mass-normalised shape.  Rigid-body modes (0 Hz)
+    have NaN.
+    """
+    f, shapes, _ = mode_shapes(p, joint)
+    lam = np.linalg.eigvals(_state_matrix(p, joint))
+    lam = lam[lam.imag > 0.0]
+    C = linear_damping(p, joint)
+    zeta = np.full(len(f), np.nan)
+    free = np.ones(len(lam), dtype=bool)
+    for i, fi in enumerate(f):
+        if fi == 0.0:
+            continue
+        omega = 2.0 * np.pi * fi
+        miss = np.where(free, np.abs(np.abs(lam) - omega), np.inf)
+        j = int(np.argmin(miss)) if len(lam) else -1
+        if j >= 0 and miss[j] <= MODE_MATCH_REL * omega:
+            zeta[i] = -lam[j].real / abs(lam[j])
+            free[j] = False
+        else:
+            zeta[i] = shapes[:, i] @ C @ shapes[:, i] / (2.0 * omega)
+    return f, zeta
+
+
 @functools.lru_cache(maxsize=256)
 def linear_eigenvalues(p: Parameters) -> np.ndarray:
     """Eigenvalues (1/s) of the damped linear system, joint free and locked (concatenated).
@@ -92,19 +147,8 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
     (docs/model.md §5): -246 +- 2.05e4 j 1/s with the tip mass, -321 +- 3.54e4 j
     without.
     """
-    out = []
-    for joint in ("free", "locked"):
-        M, K, names = linear_matrices(p, joint)
-        model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
-        C = model.kc[ly.KC_C][np.ix_(model.free, model.free)].copy()
-        if ly.S in model.free:
-            C[names.index("s"), names.index("s")] += p.cork_law.c
-        n = len(names)
-        _check_conditioned(M, K, joint)
-        Minv = np.linalg.inv(M)
-        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-        out.append(np.linalg.eigvals(A))
-    lam = np.concatenate(out)
+    lam = np.concatenate([np.linalg.eigvals(_state_matrix(p, joint))
+                          for joint in ("free", "locked")])
     lam.flags.writeable = False
     return lam
 
