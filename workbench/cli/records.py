@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..model.params import ParameterError, Parameters
-from ..study.paths import check_output_dir, check_output_file
+from ..study.paths import check_output_dir, check_output_file, staged_output
 from .common import (EXIT_NOT_CONVERGED, EXIT_OK, EXIT_RUN_FAILED, RESULTS, add_format_option,
                      add_jobs_option, add_record_options, check_window, cut,
                      json_text, number, pair_numbers, read_record,
@@ -57,8 +57,10 @@ def _cmd_compare(args) -> int:
 
 
 def _cmd_frf(args) -> int:
+    from ..experiments.channels import reference_of
     from ..experiments.formats import uff
-    from ..experiments.frf import frf, magnitude_phase, peak_table as peak_table_of, responses_of
+    from ..experiments.frf import (DEFAULT_SEGMENT_S, default_window, frf, magnitude_phase,
+                                   peak_table as peak_table_of, responses_of)
     from ..present.figures import frf_figure, save
 
     path = Path(args.file)
@@ -67,29 +69,40 @@ def _cmd_frf(args) -> int:
     uff.check_settings(Path(args.file), meta, records=len(args.response) or sum(
         str(c).startswith(("accel", "strain")) for c in record.columns))
     check_window(args.file, record, args.skip_s)
+    force = args.force or reference_of(meta.get("drive"))
+    if force not in record.columns:
+        raise ParameterError(f"--force {force}: {args.file} has no such channel (its channels: "
+                             f"{', '.join(map(str, record.columns))})")
+    window = args.window or default_window(meta.get("drive"))
     t = record.index.to_numpy()
     length = (t[-1] - t[0] - args.skip_s) * len(t) / max(len(t) - 1, 1)    # samples x dt
-    if args.segment_s > length * (1 + 1e-9):
-        raise ParameterError(f"--segment-s {args.segment_s:g}: longer than {args.file} after "
+    segment_s = args.segment_s if args.segment_s is not None else (
+        None if window in ("rect", "impact") else DEFAULT_SEGMENT_S)
+    if segment_s is not None and segment_s > length * (1 + 1e-9):
+        raise ParameterError(f"--segment-s {segment_s:g}: longer than {args.file} after "
                              f"--skip-s; allowed: (0, {length:g}] s")
     out = check_output_dir("--out", args.out or RESULTS / "frf" / path.stem)
-    out.mkdir(parents=True, exist_ok=True)
-    table = frf(record, args.response or None, force=args.force, segment_s=args.segment_s,
-                skip_s=args.skip_s)
+    table = frf(record, args.response or None, force=force, segment_s=segment_s,
+                skip_s=args.skip_s, window=window)
     responses = responses_of(table)
-    magnitude_phase(table).to_csv(out / "frf.csv")
     peak_table = peak_table_of({args.file: table}, responses, args.f_min,
                                args.f_max).drop(columns="source")
-    peak_table.to_csv(out / "peaks.csv", index=False)
-    (out / "peaks.md").write_text("# FRF peaks (H1): frequency (Hz), magnitude in its unit, "
-                                  "coherence, half-power damping ratio\n\n"
-                                  + peak_table.to_markdown(index=False, floatfmt=".4g") + "\n")
-    figures = save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against "
-                              f"{args.force}", args.f_max), out / "frf")
-    uff.write_frf(out / "frf.uff", table, responses, args.force, meta=meta)
-    print(json_text({"record": args.file, "out": str(out), "resolution_hz": float(table.index[1]),
-                     "uff": str(out / "frf.uff"),
-                     "figures": [str(p) for p in figures if p.suffix == ".png"],
+    with staged_output(out) as stage:
+        magnitude_phase(table).to_csv(stage / "frf.csv")
+        peak_table.to_csv(stage / "peaks.csv", index=False)
+        (stage / "peaks.md").write_text(
+            f"# FRF peaks (H1 against {force}, {window} window): frequency (Hz), magnitude in "
+            "its unit, coherence, half-power damping ratio"
+            + (" (corrected for the exponential window)" if window == "impact" else "")
+            + "\n\n" + peak_table.to_markdown(index=False, floatfmt=".4g") + "\n")
+        save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against {force} "
+                        f"({window} window)", args.f_max), stage / "frf")
+        uff.write_frf(stage / "frf.uff", table, responses, force, meta=meta)
+    print(json_text({"record": args.file, "out": str(out), "force": force, "window": window,
+                     "averages": table.attrs["averages"],
+                     "exp_tau_s": table.attrs.get("exp_tau_s"),
+                     "resolution_hz": float(table.index[1]), "uff": str(out / "frf.uff"),
+                     "figures": [str(out / f"frf.{ext}") for ext in ("png",)],
                      "peaks": peak_table.to_dict("records")}))
     return EXIT_OK
 
@@ -135,11 +148,18 @@ def add_parsers(sub) -> None:
 
     fr = sub.add_parser("frf", help="H1, H2 and coherence of a record or a run against its force")
     fr.add_argument("file", help="a record (.lvm .txt .tdms .uff .parquet), e.g. of workbench run --out")
-    fr.add_argument("--force", default="force1", help="the force channel (default force1)")
+    fr.add_argument("--force", default=None, help="the force channel (default: the hammer in an "
+                    "impact test's record, else force1)")
+    fr.add_argument("--window", choices=("hann", "rect", "impact"), default=None,
+                    help="hann: Welch's Hann segments (a sine, noise); rect: one record-long "
+                    "rectangular segment (a chirp); impact: force and exponential windows on one "
+                    "hit, the damping corrected (default by the record's drive: hammer impact, "
+                    "chirp rect, else hann)")
     fr.add_argument("--response", action="append", default=[],
                     help="a response channel, repeatable (default: every accel and strain)")
-    fr.add_argument("--segment-s", type=number(0, lo_open=True), default=2.0,
-                    help="Welch segment (s): the frequency resolution is 1/segment (default 2)")
+    fr.add_argument("--segment-s", type=number(0, lo_open=True), default=None,
+                    help="Welch segment (s): the frequency resolution is 1/segment (default 2 "
+                    "with the Hann window, the whole record with rect and impact)")
     fr.add_argument("--skip-s", type=number(0), default=0.0, help="leave out the first seconds")
     fr.add_argument("--f-min", type=number(0), default=0.0, help="lowest peak frequency (Hz)")
     fr.add_argument("--f-max", type=number(0, lo_open=True), default=None,

@@ -163,7 +163,8 @@ def add_parsers(sub) -> None:
     run.add_argument("--tol", type=number(0, lo_open=True), default=None,
                      help=f"relative tolerance of the controlled method (default {DEFAULT_TOL:g}; "
                      "docs/model.md 'Integration')")
-    run.add_argument("--output-hz", type=number(0, MAX_OUTPUT_HZ, lo_open=True), default=1000.0, help="sample rate of the signals")
+    run.add_argument("--output-hz", type=number(0, MAX_OUTPUT_HZ, lo_open=True), default=None,
+                     help="sample rate of the signals (Hz; default 1000, a hammer's 10 samples a pulse)")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")
     run.add_argument("--out", metavar="FILE", help="write the signals, in the format of the suffix: "

@@ -1,7 +1,8 @@
 """A record: the rig's sensor channels of Table 2, their units, and their settings.
 
 The rig's LabVIEW instruments wrote the sensors of Table 2 (seed §3.3-3.4):
-Force1, Strain1, Accel1, Contact1-4, Accel2, Strain2, Accel3.  Every file
+Force1, Strain1, Accel1, Contact1-4, Accel2, Strain2, Accel3; an impact
+test adds the hammer's force gauge (Hammer, a force channel: §4.3, §5.4).  Every file
 format (:mod:`workbench.experiments.formats`) reads into the same record: a
 DataFrame indexed by time ``t`` (s), with the workbench's channel names
 (``force1`` ... ``accel3``, ``contact1-4``) in CGS units, and the attributes
@@ -38,7 +39,8 @@ if TYPE_CHECKING:
 #: Table 2's sensor names, as the files write them, by workbench channel.
 TABLE2_NAMES = {"force1": "Force1", "strain1": "Strain1", "accel1": "Accel1",
                 "contact1": "Contact1", "contact2": "Contact2", "contact3": "Contact3",
-                "contact4": "Contact4", "accel2": "Accel2", "strain2": "Strain2", "accel3": "Accel3"}
+                "contact4": "Contact4", "accel2": "Accel2", "strain2": "Strain2", "accel3": "Accel3",
+                "hammer": "Hammer"}
 CHANNELS = tuple(TABLE2_NAMES)
 #: Unit -> factor to CGS, by kind of channel.
 UNITS = {
@@ -66,7 +68,13 @@ class ExperimentFileError(ParameterError):
 
 def kind(channel: str) -> str:
     """'force', 'strain', 'accel' or 'contact' of a workbench channel name."""
-    return re.sub(r"\d+$", "", channel)
+    return "force" if channel == "hammer" else re.sub(r"\d+$", "", channel)
+
+
+def reference_of(drive: str | None) -> str:
+    """The force channel a record's responses refer to: the hammer in an impact test
+    (a ``hammer_*`` drive), else the shaker's force1."""
+    return "hammer" if str(drive).startswith("hammer") else "force1"
 
 
 def channel_of(label: str) -> str | None:

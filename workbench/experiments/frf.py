@@ -16,6 +16,28 @@ window, half-overlapping segments): pyFRF averages separate records given
 one at a time, while a single long record, the workbench's and the lab's
 usual case, is averaged by segmenting it, which Welch's method does.
 
+The window (:data:`WINDOWS`) is the modal engineer's choice per kind of test
+(:func:`default_window`):
+
+- ``hann``: Welch's half-overlapping Hann segments, for a stationary drive
+  (a sine, noise);
+- ``rect``: rectangular segments, by default one the record's length, for a
+  transient that starts and ends inside the record (a chirp or a burst):
+  a taper would weight the modes the sweep crosses early or late and bias
+  their damping;
+- ``impact``: one hit, the field's impact-test windows (Ewins, Modal Testing,
+  2nd ed., §3.10; Fladung & Rost, "Application and correction of the
+  exponential window for frequency response functions", Mech. Syst. Signal
+  Process. 11(1), 1997): a force window that keeps the pulse (from
+  FORCE_WINDOW_MARGIN samples before the force first exceeds
+  FORCE_LEVEL of its peak to as many after it last does) and zeroes the
+  rest, and an exponential window exp(-(t - t_hit) / tau) on the response
+  from the hit, tau such that it has fallen to EXP_END at the record's end.
+  The response's level before the hit (a static offset) is removed first.
+  The exponential window adds 1 / tau to every mode's decay rate, so the
+  half-power damping is corrected by zeta = zeta_measured - 1 / (tau omega_n)
+  (Fladung & Rost, eq. 9); one hit has no coherence (NaN).
+
 The peaks of |H1| give the natural frequencies and, by the half-power
 bandwidth, the damping ratios: zeta = (f_b - f_a) / (2 f_n) with
 |H1(f_a)| = |H1(f_b)| = |H1(f_n)| / sqrt 2 (interpolated linearly).
@@ -29,8 +51,14 @@ from scipy import signal
 from ..model.params import ParameterError
 from .channels import kind
 
-#: Default segment length (s): 0.5 Hz resolution, enough to separate the modes.
+#: Default segment length (s) of the Hann window: 0.5 Hz resolution, enough to separate the modes.
 DEFAULT_SEGMENT_S = 2.0
+WINDOWS = ("hann", "rect", "impact")
+#: The impact windows (module docstring): the force's threshold (of its peak), the samples kept
+#: on either side of the pulse, and the exponential window's value at the record's end.
+FORCE_LEVEL = 0.01
+FORCE_WINDOW_MARGIN = 2
+EXP_END = 0.01
 #: The field's unit of an FRF's magnitude, by the response's kind, and its factor from the
 #: record's CGS ratio (strain per dyn, (cm/s^2) per dyn): 1 N = 1e5 dyn, 1 = 1e6 microstrain,
 #: 1 m/s^2 = 100 cm/s^2.
@@ -46,16 +74,31 @@ def field_unit(response: str) -> tuple[str, float]:
     return FIELD_UNITS[kind(response)]
 
 
+def default_window(drive: str | None) -> str:
+    """The window a modal engineer picks for a record of that drive (module docstring)."""
+    if str(drive).startswith("hammer"):
+        return "impact"
+    return "rect" if drive == "chirp" else "hann"
+
+
 def frf(record: pd.DataFrame, responses=None, force: str = "force1",
-        segment_s: float = DEFAULT_SEGMENT_S, skip_s: float = 0.0) -> pd.DataFrame:
+        segment_s: float | None = DEFAULT_SEGMENT_S, skip_s: float = 0.0,
+        window: str = "hann") -> pd.DataFrame:
     """H1, H2 and the coherence of each response channel against the force.
 
     ``record`` is indexed by time (s) with the force column (N or dyn: the
     FRF carries the ratio of the units) and the responses (default: every
-    accel and strain column).  Returns a DataFrame indexed by frequency
-    (Hz) with, per response r, the columns ``r_H1``, ``r_H2`` (complex)
-    and ``r_coherence``.  Raises ParameterError on a record it cannot use.
+    accel and strain column).  ``window`` is one of WINDOWS (module
+    docstring); ``segment_s`` the Welch segment of ``hann`` and ``rect``
+    (None: the whole record after ``skip_s``; ``impact`` takes the whole
+    record).  Returns a DataFrame indexed by frequency (Hz) with, per
+    response r, the columns ``r_H1``, ``r_H2`` (complex) and
+    ``r_coherence``; ``attrs`` holds the window and, for ``impact``, the
+    exponential window's ``exp_tau_s`` (s) that :func:`peaks` corrects the
+    damping for.  Raises ParameterError on a record it cannot use.
     """
+    if window not in WINDOWS:
+        raise ParameterError(f"window = {window!r}; allowed: {', '.join(WINDOWS)}")
     try:
         t = record.index.to_numpy(dtype=float)
     except (TypeError, ValueError):
@@ -80,14 +123,20 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
         if not np.all(np.isfinite(record[c].to_numpy(dtype=float)[keep])):
             raise ParameterError(f"the {c} column has values that are not finite")
     fs = 1.0 / dt[0]
-    if not 0.0 < segment_s <= len(t) / fs:
+    if segment_s is None or window == "impact":
+        segment_s = len(t) / fs
+    if not 0.0 < segment_s <= len(t) / fs * (1 + 1e-9):
         raise ParameterError(f"segment_s = {segment_s:g} s: allowed (0, {len(t) / fs:g}] s, the "
                              "record's length after skip_s")
     nperseg = min(len(t), max(16, int(round(segment_s * fs))))
     f_in = record[force].to_numpy(dtype=float)[keep]
     if not np.any(f_in):
         raise ParameterError(f"the {force} column is zero: no force to refer the response to")
-    kw = dict(fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2, detrend="constant")
+    if window == "impact":
+        return _impact_frf(t, f_in, {r: record[r].to_numpy(dtype=float)[keep] for r in responses})
+    taper = "hann" if window == "hann" else "boxcar"
+    kw = dict(fs=fs, window=taper, nperseg=nperseg, noverlap=nperseg // 2 if window == "hann" else 0,
+              detrend="constant")
     freq, g_ff = signal.welch(f_in, **kw)
     out = {}
     for r in responses:
@@ -101,7 +150,43 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
         out[f"{r}_H1"] = h1
         out[f"{r}_H2"] = h2
         out[f"{r}_coherence"] = np.clip(np.nan_to_num(coh.real), 0.0, 1.0)
-    return pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
+    table = pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
+    table.attrs.update(window=window, averages=1 + max(0, (len(t) - nperseg) // (nperseg - kw["noverlap"])))
+    return table
+
+
+def impact_windows(t: np.ndarray, force: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """The force window, the exponential window, tau (s) and the hit's first sample of one hit
+    (module docstring)."""
+    peak = np.max(np.abs(force))
+    above = np.flatnonzero(np.abs(force) > FORCE_LEVEL * peak)
+    first = max(0, above[0] - FORCE_WINDOW_MARGIN)
+    last = min(len(t) - 1, above[-1] + FORCE_WINDOW_MARGIN)
+    w_force = np.zeros(len(t))
+    w_force[first:last + 1] = 1.0
+    tau = (t[-1] - t[first]) / np.log(1.0 / EXP_END)
+    w_exp = np.exp(-np.clip(t - t[first], 0.0, None) / tau)
+    return w_force, w_exp, float(tau), int(first)
+
+
+def _impact_frf(t, force, responses: dict) -> pd.DataFrame:
+    """H1 = X / F of one hit with the impact windows (module docstring)."""
+    w_force, w_exp, tau, first = impact_windows(t, force)
+    n = len(t)
+    freq = np.fft.rfftfreq(n, t[1] - t[0])
+    F = np.fft.rfft(force * w_force)
+    out = {}
+    for r, x in responses.items():
+        offset = x[:first].mean() if first > 0 else x[0]
+        X = np.fft.rfft((x - offset) * w_exp)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            h = X / F
+        out[f"{r}_H1"] = h
+        out[f"{r}_H2"] = h
+        out[f"{r}_coherence"] = np.full(len(freq), np.nan)
+    table = pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
+    table.attrs.update(window="impact", averages=1, exp_tau_s=tau)
+    return table
 
 
 def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: float | None = None,
@@ -111,7 +196,10 @@ def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: flo
     where a half-power point lies outside the band).
 
     ``prominence`` is relative to the largest |H| in the band (log scale: a
-    peak must stand out by that fraction of a decade)."""
+    peak must stand out by that fraction of a decade).  After the impact
+    window the damping is corrected for the exponential window's decay
+    (module docstring)."""
+    tau = frf_table.attrs.get("exp_tau_s")
     f = frf_table.index.to_numpy()
     band = (f >= f_min) & (f <= (f_max if f_max is not None else f[-1])) & (f > 0)
     mag = np.abs(frf_table[f"{response}_{estimate}"].to_numpy())[band]
@@ -136,6 +224,8 @@ def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: flo
             fa = np.interp(level, [mag[lo], mag[lo + 1]], [fb[lo], fb[lo + 1]])
             fbb = np.interp(level, [mag[hi], mag[hi - 1]], [fb[hi], fb[hi - 1]])
             zeta = (fbb - fa) / (2.0 * fb[i])
+            if tau:
+                zeta -= 1.0 / (tau * 2.0 * np.pi * fb[i])
         rows.append({"f_hz": float(fb[i]), "magnitude": float(mag[i]) * scale, "unit": unit,
                      "coherence": float(coh[i]), "zeta_half_power": float(zeta)})
     return pd.DataFrame(rows, columns=PEAK_COLUMNS)

@@ -22,7 +22,8 @@ from typing import Callable
 import numpy as np
 
 from ..core import excitation as cx
-from .limits import FREE_DECAY_MAX_CM, MIN_PULSE_STEPS, PULSE_STEPS, STEPS_PER_PERIOD
+from .limits import (DEFAULT_OUTPUT_HZ, FREE_DECAY_MAX_CM, MIN_PULSE_SAMPLES, MIN_PULSE_STEPS,
+                     PULSE_SAMPLES, PULSE_STEPS, STEPS_PER_PERIOD)
 from .params import ParameterError, check_positive
 
 #: dyn per newton
@@ -107,13 +108,14 @@ def hammer_tip(force_n: float, width_s: float = 1e-3, t_hit_s: float = 0.0) -> n
 @dataclass(frozen=True)
 class Step:
     """A run's step and span, for a drive's check: ``dt`` (s), the run's ``end`` (s),
-    ``strict`` (the command line and studies, :func:`~workbench.model.simulate.check_settings`)
-    and ``name`` (a setting's name as the user wrote it)."""
+    ``strict`` (the command line and studies, :func:`~workbench.model.simulate.check_settings`),
+    ``name`` (a setting's name as the user wrote it) and the signals' ``output_hz``."""
 
     dt: float
     end: float
     strict: bool
     name: Callable[[str], str]
+    output_hz: float = math.inf
 
     @property
     def f_max(self) -> float:
@@ -151,6 +153,12 @@ def _check_pulse(ex, step):
         raise ParameterError(f"{step.name('width_s')} = {width:g} s is shorter than "
                              f"{MIN_PULSE_STEPS} steps dt = {step.dt:g} s: the step cannot "
                              "resolve the pulse (give a smaller dt or leave it out)")
+    if width * step.output_hz < MIN_PULSE_SAMPLES * (1.0 - 1e-9):
+        raise ParameterError(f"{step.name('output_hz')} = {step.output_hz:g} Hz samples the "
+                             f"hammer pulse of {width:g} s {width * step.output_hz:.3g} times; "
+                             f"at least {MIN_PULSE_SAMPLES} (give at least "
+                             f"{MIN_PULSE_SAMPLES / width:g} Hz, or leave it out for "
+                             f"{PULSE_SAMPLES} a pulse)")
     if step.strict and ex[cx.X_T_HIT] + width > step.end:
         raise ParameterError(f"{step.name('t_hit_s')} = {ex[cx.X_T_HIT]:g} s: the pulse of "
                              f"{width:g} s would end after the run ({step.end:g} s)")
@@ -158,6 +166,10 @@ def _check_pulse(ex, step):
 
 def _pulse_dt(ex) -> float:
     return ex[cx.X_WIDTH] / PULSE_STEPS
+
+
+def _pulse_hz(ex) -> float:
+    return max(DEFAULT_OUTPUT_HZ, PULSE_SAMPLES / ex[cx.X_WIDTH])
 
 
 def _release(settings, name) -> dict:
@@ -182,6 +194,7 @@ class Drive:
     code: int = cx.EXC_NONE                        # the array's force shape (core.excitation)
     check: Callable[[np.ndarray, Step], None] = field(default=lambda ex, step: None)
     dt_max: Callable[[np.ndarray], float] = field(default=lambda ex: math.inf)  # default step's bound (s)
+    output_hz: Callable[[np.ndarray], float] = field(default=lambda ex: DEFAULT_OUTPUT_HZ)  # default rate (Hz), at least
     ramped: bool = False                           # a soft start (ramp_s), dropped inside a stepped chain
     frequency_key: str | None = None               # the setting that is the forcing frequency
     swept: bool = False                            # the frequency sweeps over the run (chirp figures)
@@ -283,8 +296,8 @@ register(Drive("chirp", ("force_n", "f0_hz", "f1_hz", "sweep_s", "ramp_s"), lamb
 register(Drive("free_decay", ("deflection_cm",), lambda e: none(),
                start=_release))
 register(Drive("hammer_joint", ("force_n", "width_s", "t_hit_s"), lambda e: hammer_joint(**e),
-               code=cx.EXC_HAMMER_JOINT, check=_check_pulse, dt_max=_pulse_dt,
+               code=cx.EXC_HAMMER_JOINT, check=_check_pulse, dt_max=_pulse_dt, output_hz=_pulse_hz,
                defaults={"force_n": DEFAULT_HAMMER_N}))
 register(Drive("hammer_tip", ("force_n", "width_s", "t_hit_s"), lambda e: hammer_tip(**e),
-               code=cx.EXC_HAMMER_TIP, check=_check_pulse, dt_max=_pulse_dt,
+               code=cx.EXC_HAMMER_TIP, check=_check_pulse, dt_max=_pulse_dt, output_hz=_pulse_hz,
                defaults={"force_n": DEFAULT_HAMMER_N}))

@@ -29,6 +29,12 @@ STEPS_PER_PERIOD = 20
 #: Steps per hammer pulse at least when the step is given, and in the default step.
 MIN_PULSE_STEPS = 5
 PULSE_STEPS = 20
+#: Samples per hammer pulse at least, and in the default sample rate: a pulse is
+#: never lost between samples, and its force channel keeps its shape.
+MIN_PULSE_SAMPLES = 5
+PULSE_SAMPLES = 10
+#: The signals' sample rate (Hz) unless a drive needs more (a hammer: PULSE_SAMPLES a pulse).
+DEFAULT_OUTPUT_HZ = 1000.0
 #: The longest study name (it names a folder).
 MAX_NAME_CHARS = 100
 

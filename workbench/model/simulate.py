@@ -14,6 +14,7 @@ Units are CGS (docs/model.md); ``run.units`` names them per column.
 from __future__ import annotations
 
 import functools
+import math
 import sys
 import time
 from dataclasses import dataclass, field
@@ -35,7 +36,6 @@ from .statics import static_equilibrium, tip_load_for_deflection
 if TYPE_CHECKING:
     import pandas as pd
 
-DEFAULT_OUTPUT_HZ = 1000.0
 #: Steps :func:`default_dt` chooses from (s): 1 ms / n for n = 10 ... 200, so that each
 #: divides 1 ms (every output rate that divides 1 kHz, and every whole number of ms).
 NICE_STEPS = tuple(1e-3 / n for n in range(10, 201))
@@ -105,7 +105,7 @@ def stepped_dt(p: Parameters) -> float:
 
 
 def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: float | None,
-                   output_hz: float, t0: float = 0.0, names: dict | None = None,
+                   output_hz: float | None, t0: float = 0.0, names: dict | None = None,
                    strict: bool = True) -> tuple[float, int, int]:
     """Check a run's settings against what its step can resolve; return (dt, decim, n_steps).
 
@@ -147,6 +147,9 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
                     f"for the default {default_dt(params, ex):g} s")
     else:
         dt = default_dt(params, ex)
+    drive = drives.of_array(ex)
+    if output_hz is None:           # the drive's rate at least, dividing 1/dt
+        output_hz = 1.0 / (dt * max(1, math.floor(1.0 / (dt * drive.output_hz(ex)) + 1e-9)))
     output_hz = check_positive(name("output_hz"), output_hz, "Hz")
     decim = round(1.0 / (output_hz * dt)) if output_hz * dt > 1e-12 else 0
     if decim < 1 or abs(decim * dt * output_hz - 1.0) > 1e-9:
@@ -156,7 +159,7 @@ def check_settings(params: Parameters, ex: np.ndarray, duration: float, dt: floa
     if abs(n_steps * dt - duration) > 1e-9 * duration:
         raise ParameterError(f"{name('duration')} = {duration:g} s is not a whole number of "
                              f"steps dt = {dt:g} s")
-    drives.of_array(ex).check(ex, drives.Step(dt, t0 + duration, strict, name))
+    drive.check(ex, drives.Step(dt, t0 + duration, strict, name, 1.0 / (decim * dt)))
     return dt, decim, n_steps
 
 
@@ -394,7 +397,7 @@ def initial_state(p: Parameters, initial="static", fixed=(), free_decay_cm: floa
 
 
 def simulate(params: Parameters, excitation: np.ndarray | None = None, duration: float = 1.0, *,
-             dt: float | None = None, output_hz: float = DEFAULT_OUTPUT_HZ, initial="static",
+             dt: float | None = None, output_hz: float | None = None, initial="static",
              free_decay_cm: float | None = None, fixed=(), progress: bool = False,
              t0: float = 0.0, regime: int = 0, method: str | None = None,
              tol: float | None = None, level_max: int = DEFAULT_LEVEL_MAX) -> Run:
@@ -411,7 +414,8 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     ``tol``.  ``dt`` (s) is the fixed step, or the controlled method's
     coarsest; by default :func:`default_dt`.
     ``output_hz`` is the sample rate of the signals; 1 / (output_hz dt)
-    must be a whole number.  ``fixed`` holds coordinates (tests, locked
+    must be a whole number.  By default limits.DEFAULT_OUTPUT_HZ, or for a hammer
+    PULSE_SAMPLES samples a pulse (the next rate dividing 1 / dt).  ``fixed`` holds coordinates (tests, locked
     joint).  Never raises on a failure of the integration: the run stops
     with a status code and keeps what it computed.
     """

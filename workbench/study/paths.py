@@ -7,7 +7,10 @@ system allows, no write permission.
 """
 from __future__ import annotations
 
+import contextlib
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 from ..model.params import ParameterError
@@ -64,3 +67,20 @@ def check_output_file(option: str, file: str | os.PathLike, suffixes=()) -> Path
     if not os.access(target, os.W_OK):
         raise ParameterError(f"{option} {file}: {target} is not writable")
     return path
+
+
+@contextlib.contextmanager
+def staged_output(folder: Path):
+    """A scratch folder beside ``folder`` to write the outputs into; on success its files
+    move into ``folder`` (created then), on an error it is removed: a failed command leaves
+    no half-written folder and replaces none of the files already there."""
+    folder = Path(folder)
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=f".{folder.name}.partial-", dir=folder.parent))
+    try:
+        yield scratch
+        folder.mkdir(exist_ok=True)
+        for item in sorted(scratch.iterdir()):
+            os.replace(item, folder / item.name)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)

@@ -6,11 +6,14 @@ A record is written as, in order:
 - dataset 164, the units: SI (m, N, s), as the file's values are;
 - dataset 2411, the nodes: one per sensor of Table 2 at its rest position on
   the rig (m; x along the beam from the clamp, y up, z across), numbered as
-  :data:`NODES` (1 Force1 ... 10 Accel3);
+  :data:`NODES` (1 Force1 ... 10 Accel3, 11 the hammer's struck point: the
+  joint body's base for ``hammer_joint``, beam B's tip for ``hammer_tip``);
 - dataset 58, one time history per channel (function type 1): response node
   and direction the sensor's (+Y for force and acceleration, +X for the
-  surface strains, +Y for the contact patches), reference node the shaker
-  (Force1, +Y), the ordinate's specific data type and units label
+  surface strains, +Y for the contact patches; the hammer +Y at the joint,
+  +X along beam B at its tip), reference node and direction the drive's
+  force (the hammer in an impact test, else the shaker, Force1, +Y), the
+  ordinate's specific data type and units label
   (:data:`ORDINATE`), abscissa time (s) with even spacing.  ID line 1 is the
   Table 2 name; ID lines 4 and 5 carry the settings as ``WB_key=value``
   words (UFF has no other place for them), spread over the records.
@@ -28,7 +31,7 @@ import numpy as np
 
 from ..channels import (CHANNELS, DEFAULT_UNITS, META_PREFIX, TABLE2_NAMES, ExperimentFileError,
                         channel_of, factor, for_writing, kind, labels_to_channels, meta_value,
-                        record, time_step)
+                        record, reference_of, time_step)
 
 #: Node number of each channel's sensor.
 NODES = {c: i + 1 for i, c in enumerate(CHANNELS)}
@@ -43,8 +46,19 @@ TIME_TYPE, FREQUENCY_TYPE = 17, 18
 LINE = 80
 
 
-def sensor_positions(p=None) -> dict[str, tuple[float, float, float]]:
-    """Rest position (m) of each sensor of Table 2 (MODEL.md §9), the gap centred."""
+def hammer_direction(drive: str | None) -> int:
+    """The hammer's UFF direction: +X along beam B at its tip, else +Y (docs/model.md §8)."""
+    return 1 if drive == "hammer_tip" else 2
+
+
+def direction(channel: str, drive: str | None) -> int:
+    """A channel's UFF direction code in a record of that drive."""
+    return hammer_direction(drive) if channel == "hammer" else DIRECTIONS[kind(channel)]
+
+
+def sensor_positions(p=None, drive: str | None = None) -> dict[str, tuple[float, float, float]]:
+    """Rest position (m) of each sensor of Table 2 (MODEL.md §9), the gap centred, and of the
+    hammer's struck point for that drive (the joint body's base, or beam B's tip)."""
     from ...model.params import Parameters
 
     p = p or Parameters()
@@ -55,7 +69,8 @@ def sensor_positions(p=None) -> dict[str, tuple[float, float, float]]:
           "contact1": (p.l_a + p.x_in, -p.h4 / 2.0), "contact2": (p.l_a + p.x_in, p.h4 / 2.0),
           "contact3": (p.l_a + p.x_lip, -lip), "contact4": (p.l_a + p.x_lip, lip),
           "accel2": (p.l_a + p.x_in + p.x_accel2, 0.0), "strain2": (root_b + p.x_strain2, 0.0),
-          "accel3": (root_b + p.x_accel3, 0.0)}
+          "accel3": (root_b + p.x_accel3, 0.0),
+          "hammer": (p.l_a, 0.0) if drive == "hammer_joint" else (root_b + p.l_b, 0.0)}
     return {c: (x / 100.0, y / 100.0, 0.0) for c, (x, y) in cm.items()}
 
 
@@ -142,10 +157,10 @@ def check_settings(path, meta: dict | None, records: int = len(CHANNELS)) -> Non
     _setting_lines(meta, 2 * records, path)
 
 
-def _header_sets(path: Path, p=None) -> list[dict]:
+def _header_sets(path: Path, p=None, drive: str | None = None) -> list[dict]:
     import pyuff
 
-    positions = sensor_positions(p)
+    positions = sensor_positions(p, drive)
     nodes = [NODES[c] for c in CHANNELS]
     return [pyuff.prepare_151(model_name=path.stem, description="loose bolted lap joint rig, "
                               "sensors of Table 2", db_app="workbench", program="workbench"),
@@ -181,14 +196,16 @@ def write(path, record, meta: dict | None = None) -> Path:
         raise ExperimentFileError(path, None, "UFF time histories need a uniform time base")
     settings = _setting_lines(meta, 2 * len(channels), path)
     now = f"{_dt.datetime.now():%d-%b-%y %H:%M:%S}"
-    sets = _header_sets(path, _parameters(meta))
+    drive = (meta or {}).get("drive")
+    sets = _header_sets(path, _parameters(meta), drive)
+    ref = reference_of(drive)
     for i, (c, column) in enumerate(zip(channels, values.T)):
         length_exp, force_exp = EXPONENTS[kind(c)]
         sets.append(_record_58(
             id1=TABLE2_NAMES[c], id2="workbench record", id3=now, id4=settings[2 * i],
             id5=settings[2 * i + 1], func_type=1, rsp_ent_name=TABLE2_NAMES[c], rsp_node=NODES[c],
-            rsp_dir=DIRECTIONS[kind(c)], ref_ent_name="Force1", ref_node=NODES["force1"],
-            ref_dir=DIRECTIONS["force"], abscissa_spacing=1, abscissa_min=float(t[0]),
+            rsp_dir=direction(c, drive), ref_ent_name=TABLE2_NAMES[ref], ref_node=NODES[ref],
+            ref_dir=direction(ref, drive), abscissa_spacing=1, abscissa_min=float(t[0]),
             abscissa_inc=float(step), abscissa_spec_data_type=TIME_TYPE,
             abscissa_axis_units_lab="s", ordinate_spec_data_type=ORDINATE[kind(c)],
             ordinate_len_unit_exp=length_exp, ordinate_force_unit_exp=force_exp,
@@ -208,7 +225,8 @@ def write_frf(path, table, responses, force: str = "force1", estimate: str = "H1
     step = float(f[1] - f[0])
     settings = _setting_lines(meta, 2 * len(responses), path)
     now = f"{_dt.datetime.now():%d-%b-%y %H:%M:%S}"
-    sets = _header_sets(path, _parameters(meta))
+    drive = (meta or {}).get("drive")
+    sets = _header_sets(path, _parameters(meta), drive)
     f_unit = DEFAULT_UNITS["force"]
     for i, r in enumerate(responses):
         k = kind(r)
@@ -218,7 +236,7 @@ def write_frf(path, table, responses, force: str = "force1", estimate: str = "H1
             id1=f"{TABLE2_NAMES[r]}/{TABLE2_NAMES[force]} {estimate}", id2="workbench FRF",
             id3=now, id4=settings[2 * i], id5=settings[2 * i + 1], func_type=4,
             rsp_ent_name=TABLE2_NAMES[r], rsp_node=NODES[r], rsp_dir=DIRECTIONS[k],
-            ref_ent_name=TABLE2_NAMES[force], ref_node=NODES[force], ref_dir=DIRECTIONS["force"],
+            ref_ent_name=TABLE2_NAMES[force], ref_node=NODES[force], ref_dir=direction(force, drive),
             abscissa_spacing=1, abscissa_min=float(f[0]), abscissa_inc=step,
             abscissa_spec_data_type=FREQUENCY_TYPE, abscissa_axis_units_lab="Hz",
             ordinate_spec_data_type=ORDINATE[k], ordinate_len_unit_exp=length_exp,
