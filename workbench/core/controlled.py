@@ -85,14 +85,19 @@ def _took_stepped(st, snap):
 
 
 @nb.njit(**JIT_INLINE)
-def _path(t0, m0, n, h, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-          ev, log, n_log, st):
-    """n lattice steps of h (s), the j-th ending at t0 + (m0 + j) h.
+def _path(t0, m0, n, dt, lev, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+          ev, log, n_log, st, sample, step0, decim, stored, out_t, out_y, out_sig):
+    """n lattice steps h = dt / 2^lev (s), the j-th ending at t0 + (m0 + j) h.
 
+    With ``sample`` true, the state at every lattice point that is a base step b
+    (counted from the run's start: step0 at t0) with b % decim == 0 is stored
+    (out index ``stored`` for the first such point after the path's start, and on).
     Returns ``(status, n_log, stepped_left)``; LOG_FULL when the log has no
     room for a step's events.
     """
+    h = dt / (1 << lev)
     t = t0 + m0 * h
+    b_start = step0 + (m0 >> lev)
     for j in range(1, n + 1):
         if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
             return ly.LOG_FULL, n_log, stepped_left
@@ -101,6 +106,13 @@ def _path(t0, m0, n, h, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stage
                                                  ev, log, n_log, st)
         if status != ly.OK:
             return status, n_log, stepped_left
+        if sample and (m0 + j) % (1 << lev) == 0:
+            b = step0 + ((m0 + j) >> lev)
+            if b % decim == 0:
+                status = _store(stored + b // decim - b_start // decim - 1, t, P, tab, kc, free,
+                                ex, rec, mat, vec, stages, cg, cw, rg, st, out_t, out_y, out_sig)
+                if status != ly.OK:
+                    return status, n_log, stepped_left
     return ly.OK, n_log, stepped_left
 
 
@@ -225,8 +237,9 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
 
     As :func:`workbench.core.hybrid.run_hybrid` (chunks by ``step0``,
     samples every ``decim`` base steps, LOG_FULL after a whole interval),
-    with control intervals of ``seg`` base steps (seg divides decim,
-    n_steps and step0), each integrated at the level of ``ctl[CTL_LEVEL]``
+    with control intervals of ``seg`` base steps (seg divides n_steps and
+    step0; the samples inside an interval are those of its accepted fine
+    path), each integrated at the level of ``ctl[CTL_LEVEL]``
     or finer, the fine paths' steps down to dt / 2^level_max (level_max >= 1;
     module docstring).  ``tol`` > 0 is the
     relative tolerance.  ``snap`` (N_SNAP, N_AUG) is scratch; ``ctl``
@@ -238,7 +251,7 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
     """
     n_out = out_t.shape[0]
     need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
-    if (y0.shape[0] != ly.N_AUG or decim < 1 or seg < 1 or decim % seg != 0
+    if (y0.shape[0] != ly.N_AUG or decim < 1 or seg < 1
             or n_steps % seg != 0 or step0 % seg != 0 or n_out < need or out_y.shape[0] < need
             or out_sig.shape[0] < need or log.shape[0] < 4 * (MAX_EVENTS_PER_STEP + 2)
             or not tol > 0.0 or level_max < 1 or snap.shape[0] < ly.N_SNAP):
@@ -258,8 +271,9 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
         _save(ly.SNAP_START, t, stepped_left, stages, rg, ev, st, snap)
         k = int(ctl[ly.CTL_LEVEL])
         n = seg << k
-        status, end_c, left_c = _path(t0, i * n, n, dt / (1 << k), stepped_left, P, tab, kc, free,
-                                      ex, rec, mat, vec, stages, cg, cw, rg, ev, log, n_log, st)
+        status, end_c, left_c = _path(t0, i * n, n, dt, k, stepped_left, P, tab, kc, free, ex,
+                                      rec, mat, vec, stages, cg, cw, rg, ev, log, n_log, st,
+                                      False, step0, decim, stored, out_t, out_y, out_sig)
         ctl[ly.CTL_WORK] += n
         if status == ly.LOG_FULL:
             _restore(ly.SNAP_START, stages, rg, ev, st, snap)
@@ -271,8 +285,9 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
             t, stepped_left = _restore(ly.SNAP_START, stages, rg, ev, st, snap)
             n = seg << (k + 1)
             h = dt / (1 << (k + 1))
-            status, end_f, left_f = _path(t0, i * n, n, h, stepped_left, P, tab, kc, free, ex,
-                                          rec, mat, vec, stages, cg, cw, rg, ev, log, end_c, st)
+            status, end_f, left_f = _path(t0, i * n, n, dt, k + 1, stepped_left, P, tab, kc, free,
+                                          ex, rec, mat, vec, stages, cg, cw, rg, ev, log, end_c,
+                                          st, True, step0, decim, stored, out_t, out_y, out_sig)
             ctl[ly.CTL_WORK] += n
             if status == ly.LOG_FULL:
                 _restore(ly.SNAP_START, stages, rg, ev, st, snap)
@@ -329,10 +344,6 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
         t = t0 + (i + 1) * seg * dt
         _grow_scales(stages[ly.STAGE_CUR], rg, scale, ctl)
         st[ly.ST_STEP] = step0 + (i + 1) * seg
-        if (step0 + (i + 1) * seg) % decim == 0:
-            status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
-                            out_t, out_y, out_sig)
-            if status != ly.OK:
-                return status, stored, n_log
-            stored += 1
+        # the accepted fine path stored the samples of the interval
+        stored += (step0 + (i + 1) * seg) // decim - (step0 + i * seg) // decim
     return ly.OK, stored, n_log

@@ -24,7 +24,7 @@ import numpy as np
 
 from . import packing as mdl
 from ..core import excitation as cx, layout as ly
-from . import drives
+from . import antialias, drives
 from .drives import none
 from .tableaus import write_tableau
 from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
@@ -228,6 +228,7 @@ class Run:
     method: str = "rk4"
     tol: float | None = None    # the controlled method's relative tolerance
     control: dict = field(default_factory=dict)   # steps, rejections, error estimate (summary())
+    anti_alias: dict = field(default_factory=dict)  # the analog channels' filter (antialias.summary)
 
     @property
     def ok(self) -> bool:
@@ -333,6 +334,7 @@ class Run:
             "tol": self.tol,
             **{key: value for key, value in self.control.items() if key != "floor_intervals"},
             "floor_intervals": self.control.get("floor_intervals", [])[:SUMMARY_FLOOR_ROWS],
+            "anti_alias": self.anti_alias,
             "initial": self.initial,
             "n_events": int((kinds != ly.KIND_START).sum()),
             "n_impacts": int((kinds == ly.KIND_IMPACT).sum()),
@@ -447,6 +449,11 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     st = np.zeros(ly.N_ST)
     chunk = max(decim, (round(_CHUNK_S / dt) // decim) * decim)
     kernel = METHODS[method].kernel
+    # the kernels sample every k base steps; the record keeps every m-th, its analog
+    # channels low-pass filtered first (antialias)
+    k = antialias.internal_decimation(decim, dt, np.abs(_eigenvalues(params)).max() / (2 * np.pi))
+    m = decim // k
+    decimator = antialias.Decimator(m, 1.0 / (k * dt))
     if METHODS[method].controlled:
         seg = segment_steps(decim, n_steps)
         ctl = np.zeros(ly.N_CTL)
@@ -464,23 +471,28 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
-    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, decim, *settings, *model, ex, *work,
+    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
                                         np.empty(1), np.empty((1, ly.N_STATE)),
                                         np.empty((1, ly.N_SIG)), np.empty((1, ly.N_LOG)), st,
                                         *controller))
     t_wall = time.perf_counter()
+    parts_analog = []
+    n_internal = 0          # internal samples so far: output sample j is internal sample j m
     while done < n_steps:
         n = min(chunk, n_steps - done)
-        n_out = (done + n) // decim - done // decim + (1 if done == 0 else 0)
+        n_out = (done + n) // k - done // k + (1 if done == 0 else 0)
         out_t = np.empty(n_out)
         out_y = np.empty((n_out, ly.N_STATE))
         out_sig = np.empty((n_out, ly.N_SIG))
         log = np.empty((log_rows, ly.N_LOG))
-        status, stored, n_log = kernel(y, t0 + done * dt, dt, n, done, decim, *settings, *model, ex,
+        status, stored, n_log = kernel(y, t0 + done * dt, dt, n, done, k, *settings, *model, ex,
                                        *work, out_t, out_y, out_sig, log, st, *controller)
-        parts_t.append(out_t[:stored])
-        parts_y.append(out_y[:stored])
-        parts_s.append(out_sig[:stored])
+        keep = slice((-n_internal) % m, stored, m)
+        parts_t.append(out_t[keep])
+        parts_y.append(out_y[keep])
+        parts_s.append(out_sig[keep])
+        parts_analog.append(decimator.push(out_sig[:stored]))
+        n_internal += stored
         parts_log.append(log[:n_log].copy())
         new_done = int(st[ly.ST_STEP]) if status in (ly.OK, ly.LOG_FULL) else done
         if status == ly.OK:
@@ -495,12 +507,16 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
             break
         done = new_done
         status = ly.OK
+    parts_analog.append(decimator.finish())
+    parts_s = [np.concatenate(parts_s)]
+    parts_s[0][:, antialias.ANALOG_COLUMNS] = np.concatenate(parts_analog)
     wall = time.perf_counter() - t_wall
     if bar is not None:
         bar.close()
     run = _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
                     st, static_tip, label, t0)
     run.compile_s = compile_s
+    run.anti_alias = antialias.summary(m, 1.0 / (k * dt))
     run.method = method
     run.tol = tol
     run.control = (control_summary(controller[1], controller[3], tol, dt, duration) if controller
