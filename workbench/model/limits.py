@@ -41,3 +41,15 @@ MAX_NAME_CHARS = 100
 #: :func:`workbench.model.simulate.default_dt` asks RK4 to be stable for every eigenvalue of the
 #: linear model scaled by this factor: room for the stiffening of contact.
 STABILITY_MARGIN = 1.25
+
+# --- the range a run's response is validated for (study tables and maps flag points outside) ---
+#: The tip's largest deflection from its static equilibrium (cm): the paper's deflection test,
+#: "slightly higher than the deflections seen in shaker tests" (seed §5.3); beyond it the
+#: beams' small-slope shapes (cubic Hermite, linear strain) were not compared with the rig.
+VALID_TIP_CM = 8.4
+#: The accelerometers' range (g): PCB Piezotronics 352A24 (seed Table 1), +-50 g peak by the
+#: maker's datasheet (ASSUMPTION: the paper names the model, not its range).
+ACCEL_RANGE_G = 50.0
+#: The force transducer's range (N): PCB Piezotronics 208C03 (seed Table 1), 2224 N (500 lbf)
+#: by the maker's datasheet (ASSUMPTION, as above).
+FORCE_RANGE_N = 2224.0

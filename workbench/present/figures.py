@@ -68,7 +68,8 @@ def _ok(table):
 
 
 def frf_maps(table: pd.DataFrame, quantity: str = "tip_rms"):
-    """Colour map of ``quantity`` over gap x drive frequency; 'x' marks points not steady."""
+    """Colour map of ``quantity`` over gap x drive frequency; '*' marks points not steady,
+    '!' points outside the validated range (``metrics.validity``)."""
     parts = panels(table, ("gap_mm", "freq_hz"))
     fig, axes = _grid(len(parts), sharex=True, sharey=True)
     values = _ok(table)[quantity].to_numpy()
@@ -87,14 +88,16 @@ def frf_maps(table: pd.DataFrame, quantity: str = "tip_rms"):
                        extent=(-0.5, len(freqs) - 0.5, -0.5, len(gaps) - 0.5))
         for _, r in _ok(part).iterrows():
             ax.text(np.searchsorted(freqs, r.axis_freq_hz), np.searchsorted(gaps, r.axis_gap_mm),
-                    f"{r[quantity]:.2g}" + ("" if r.steady else "*"), ha="center", va="center",
+                    f"{r[quantity]:.2g}" + ("" if r.steady else "*")
+                    + ("!" if r.get("out_of_range", "") else ""), ha="center", va="center",
                     fontsize=6, color="w")
         ax.set_xticks(range(len(freqs)), [f"{f:g}" for f in freqs], fontsize=7)
         ax.set_yticks(range(len(gaps)), [f"{g:g}" for g in gaps])
         ax.set_title(title, fontsize=9)
         ax.set_xlabel(label("freq_hz"))
         ax.set_ylabel(label("gap_mm"))
-    fig.colorbar(im, ax=axes, label=f"{QUANTITIES[quantity]}; *: not steady, blank: failed")
+    fig.colorbar(im, ax=axes, label=f"{QUANTITIES[quantity]}; *: not steady, "
+                 "!: outside the validated range, blank: failed")
     return fig
 
 

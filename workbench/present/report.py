@@ -208,6 +208,30 @@ def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
     return lines
 
 
+def range_lines(table: pd.DataFrame) -> list[str]:
+    """Every finished point whose response left the range the model is validated for
+    (``metrics.validity``: the tip beyond the paper's 8.4 cm, the slide beyond the slot's
+    travel, an accelerometer or the force transducer beyond its range)."""
+    if "out_of_range" not in table:
+        return []
+    over = table[(table.status == "ok") & (table.out_of_range.fillna("") != "")]
+    if not len(over):
+        return ["Every point stayed within the validated range (tip within 8.4 cm of its "
+                "static position, the slide within the slot's travel, the sensors within "
+                "their ranges).", ""]
+    lines = ["## Points outside the validated range", "",
+             "The tip beyond the paper's 8.4 cm (§5.3; the beams' small-slope shapes were "
+             "compared with the rig up to there), the slide beyond the slot's travel (the "
+             "end stop, an ASSUMPTION, carries it), or a sensor beyond its range (50 g, "
+             "2224 N: a lab's record would be clipped). Marked '!' in the maps.", "",
+             "| point | outside | tip max (cm) | slide max (cm) | accel max (g) | force1 max (N) |",
+             "|---|---|---|---|---|---|"]
+    lines += [f"| {point_title(r)} | {r.out_of_range} | {r.tip_abs_max_cm:.3g} | "
+              f"{r.slide_abs_max_cm:.3g} | {r.accel_abs_max_g:.3g} | {r.force1_abs_max_n:.3g} |"
+              for _, r in over.iterrows()]
+    return lines + [""]
+
+
 def render_index(study, table, figures, tables, out) -> str:
     s = summary(table)
     lines = [f"# Study `{study.name}`", "", study.description, "",
@@ -225,6 +249,7 @@ def render_index(study, table, figures, tables, out) -> str:
                   f"{r.message} |" for _, r in failed.iterrows()]
         lines.append("")
     lines += accuracy_lines(study, table)
+    lines += range_lines(table)
     lines += ["## Tables", ""]
     for p in tables:
         lines.append(f"- [{p.name}]({p.relative_to(out)})")

@@ -10,8 +10,9 @@ other axes (tip mass, cork, ...):
 
 The CSV is long (one row per point, every column, ``steady`` and
 ``status`` included).  The Markdown and LaTeX tables pivot one quantity per
-block: gap rows, frequency columns; ``*`` marks a point that is not steady
-and ``failed`` one that did not finish.  A study without both axes gets
+block: gap rows, frequency columns; ``*`` marks a point that is not steady,
+``!`` one whose response left the validated range (``out_of_range`` in the
+CSV: ``metrics.validity``) and ``failed`` one that did not finish.  A study without both axes gets
 the long table in every format.  A study of chirps also gets ``frf_peaks``,
 the peaks of each point's FRFs (:func:`write_frf_peaks`).
 """
@@ -42,12 +43,14 @@ def with_dominant_code(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def cell(row, quantity: str) -> str:
-    """A point's value as printed: 3 significant digits, '*' if not steady."""
+    """A point's value as printed: 3 significant digits, '*' if not steady, '!' if outside
+    the validated range."""
     if row.status != "ok":
         return "failed"
     v = row[quantity]
     text = f"{v:.3g}" if isinstance(v, float) else str(v)
-    return text if bool(row.steady) else text + "*"
+    text = text if bool(row.steady) else text + "*"
+    return text + "!" if row.get("out_of_range", "") else text
 
 
 def pivots(table: pd.DataFrame, quantity: str) -> list[tuple[str, pd.DataFrame]]:
@@ -73,7 +76,8 @@ def latex_text(text: str) -> str:
 
 def _long(table: pd.DataFrame, columns: dict) -> pd.DataFrame:
     axes = [c for c in table.columns if c.startswith("axis_")]
-    keep = axes + [c for c in ("status", "message", "steady", "steady_change", *columns)
+    keep = axes + [c for c in ("status", "message", "steady", "steady_change", "out_of_range",
+                               *columns)
                    if c in table]
     return table[keep].rename(columns={c: c[5:] for c in axes})
 

@@ -10,6 +10,8 @@
     dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
                                      # controlled method's coarsest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
+    tip_limit_cm = 5.0               # optional: a response-limited drive, each point's force the
+                                     # largest up to force_n keeping the tip within it (leveling.py)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
                                      # (each selector names axis values; {} selects every point)
 
@@ -51,8 +53,7 @@ from ..model.params import ParameterError, Parameters, check_positive, read_toml
 
 SWEEP_MODES = ("independent", "up", "down", "up-down")
 STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz", "tol",
-              "method",
-              "save_series", "initial"}
+              "method", "tip_limit_cm", "save_series", "initial"}
 
 
 class StudyError(ParameterError):
@@ -104,6 +105,7 @@ class Study:
     source: str = ""
     method: str = "controlled"
     tol: float | None = None
+    tip_limit_cm: float | None = None
     points: tuple = field(default=(), repr=False)
 
     @property
@@ -184,6 +186,9 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     if abs(duration * output_hz - round(duration * output_hz)) > 1e-9 * duration * output_hz:
         raise StudyError(f"[study] duration_s = {duration} s must be a whole number of samples "
                          f"at output_hz = {output_hz} Hz (the last sample is the final state)")
+    tip_limit = head.get("tip_limit_cm")
+    if tip_limit is not None:
+        tip_limit = check_positive("[study] tip_limit_cm", tip_limit, "cm")
     initial = head.get("initial", "static")
     if initial not in ("static", "paper"):
         raise StudyError(f"[study] initial = {initial!r}; allowed: 'static', 'paper'")
@@ -230,6 +235,9 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                      if drives.DRIVES[drive].default(k) is None)
     if missing:
         raise StudyError(f"a {drive!r} excitation needs {missing} in [excitation] or [axes]")
+    if tip_limit is not None and "force_n" not in drives.DRIVES[drive].keys:
+        raise StudyError(f"[study] tip_limit_cm sets each point's force: a {drive!r} excitation "
+                         "has no force_n")
     frequency = drives.DRIVES[drive].frequency_key
     if sweep != "independent" and (frequency is None or frequency not in axes):
         raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a drive "
@@ -272,7 +280,8 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     return Study(name=name, description=str(head.get("description", "")), duration_s=duration,
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
                  excitation={"drive": drive, **exc}, fixed=fixed, axes=axes, save_series=series,
-                 source=source, points=tuple(points), method=method, tol=tol)
+                 source=source, points=tuple(points), method=method, tol=tol,
+                 tip_limit_cm=tip_limit)
 
 
 def _short(value) -> str:

@@ -23,6 +23,16 @@ Bifurcation samples: ``tip_poincare`` lists the tip displacement (cm) once
 per forcing period, at t = k / f within the window (the drive's phase 0),
 interpolated by a cubic spline through the samples (sine runs only).
 
+The validated range (over the whole run; :func:`validity`): ``tip_abs_max_cm``
+(the tip's largest deflection from its static equilibrium), ``slide_abs_max_cm``
+(the loose body's largest |s|), ``accel_abs_max_g`` (the largest |accel1-3|, in
+g), ``force1_abs_max_n``; ``out_of_range`` names the limits a run exceeds, comma
+separated ("" within all): ``tip`` beyond VALID_TIP_CM (the paper's 8.4 cm: the
+small-slope beam shapes were compared with the rig up to there), ``slot`` beyond
+the slot's travel s_travel (the end stop, an ASSUMPTION, carries the body),
+``accel`` and ``force`` beyond the sensors' ranges (ACCEL_RANGE_G, FORCE_RANGE_N:
+a measured record would be clipped there).
+
 Steady-state indicator (the first mode, ~2 Hz with zeta < 1 %, rings for
 tens of seconds): ``steady_change`` = |RMS_last - RMS_previous| / RMS_last
 of the tip displacement over the last two windows; ``steady`` is
@@ -36,6 +46,7 @@ import numpy as np
 
 from ..model import regimes
 from ..model.regimes import contact_shares_of, regime_time_of
+from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
 from ..model.simulate import CONTACT_STAT_KEYS
 
 CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
@@ -123,6 +134,28 @@ def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
     return contact_shares_of(events.t.to_numpy(), events.to_regime.to_numpy(), t0, t1)
 
 
+G_CM_S2 = 980.665
+N_DYN = 1e5
+
+
+def validity(run) -> dict:
+    """The run's largest responses against the range the model is validated for (module
+    docstring)."""
+    sig = run.signals
+    tip = float(np.nanmax(np.abs(sig.tip_y.to_numpy() - run.static_tip_y)))
+    slide = float(np.abs(sig.s.to_numpy()).max())
+    accel = float(max(np.abs(sig[c].to_numpy()).max() for c in ("accel1", "accel2", "accel3")))
+    force = float(np.abs(sig.force1.to_numpy()).max())
+    out = {"tip_abs_max_cm": tip, "slide_abs_max_cm": slide, "accel_abs_max_g": accel / G_CM_S2,
+           "force1_abs_max_n": force / N_DYN}
+    over = [name for name, value, limit in (
+        ("tip", tip, VALID_TIP_CM), ("slot", slide, run.params.s_travel),
+        ("accel", out["accel_abs_max_g"], ACCEL_RANGE_G),
+        ("force", out["force1_abs_max_n"], FORCE_RANGE_N)) if value > limit]
+    out["out_of_range"] = ",".join(over)
+    return out
+
+
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
                   steady_tol: float = STEADY_TOL) -> dict:
     """The metrics of the module docstring for a finished :class:`~workbench.model.simulate.Run`."""
@@ -167,6 +200,7 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
     for name, col in DISSIPATION.items():
         x = sig[col].to_numpy()
         out[f"diss_{name}"] = float((x[-1] - x[win][0]) / cycles)
+    out.update(validity(run))
     return out
 
 

@@ -33,8 +33,10 @@ import numpy as np
 import pandas as pd
 
 from ..core import layout as ly
+from .leveling import limited_run
 from .metrics import contact_checks, point_metrics
 from .provenance import code_version
+from ..model.drives import excitation_array
 from ..model.methods import METHODS
 from ..model.simulate import default_dt, simulate
 from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
@@ -56,6 +58,7 @@ def point_key(study: Study, point: Point, previous_key: str = "") -> str:
         "first_in_chain": point.step == 0, "duration_s": study.duration_s,
         "window_s": study.window_s, "dt": study.dt, "output_hz": study.output_hz,
         "method": study.method, "tol": study.tol, "initial": study.initial, "previous": previous_key, "code": code_version(),
+        "tip_limit_cm": study.tip_limit_cm,
     }
     text = json.dumps(record, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -99,11 +102,21 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> 
     t0 = time.perf_counter()
     continued = initial is not None
     try:
-        run = simulate(point.params, point.excitation_array(first_in_chain=not continued),
-                       study.duration_s, dt=study.dt, output_hz=study.output_hz,
-                       method=study.method, tol=study.tol, initial=initial if continued else study.initial,
-                       **point.start_keywords)
-        metrics = point_metrics(run, study.window_s, point.drive_hz) if run.ok else {}
+        def simulate_at(force_n=None):
+            settings = point.excitation if force_n is None else {**point.excitation,
+                                                                  "force_n": force_n}
+            return simulate(point.params, excitation_array(settings, first_in_chain=not continued),
+                            study.duration_s, dt=study.dt, output_hz=study.output_hz,
+                            method=study.method, tol=study.tol,
+                            initial=initial if continued else study.initial, **point.start_keywords)
+        if study.tip_limit_cm is None:
+            run = simulate_at()
+            level = {}
+        else:
+            run, force, runs, met = limited_run(simulate_at, point.excitation["force_n"],
+                                                study.tip_limit_cm)
+            level = {"force_n_used": force, "level_runs": runs, "level_met": met}
+        metrics = {**level, **point_metrics(run, study.window_s, point.drive_hz)} if run.ok else level
         row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)
         if study.saves_series(point):
