@@ -21,9 +21,6 @@ s = simulate(p.replace(gap_mm=1.016), sine(DEFAULT_FORCE_N, 20.0, ramp_s=1.0), 1
 print("10 s run", {k: s[k] for k in ("n_events", "n_impacts", "energy_balance_rel", "max_penetration_cm", "max_drift_cm", "wall_s")})
 
 # The kernel at the default step against the slow reference with events (workbench/reference/events.py)
-import sys  # noqa: E402
-from pathlib import Path  # noqa: E402
-
 from workbench.reference import HybridReference  # noqa: E402
 from workbench.core import layout as ly  # noqa: E402
 k = simulate(p, None, 0.036, initial="paper")

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.core import excitation as cx, layout as ly
+from workbench.core import excitation as cx
 from workbench.core.contact import regime_of as kernel_regime_of
 from workbench.experiments.matching import setup_from
 from workbench.model import drives, regimes

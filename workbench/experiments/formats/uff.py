@@ -186,8 +186,6 @@ def _record_58(**fields) -> dict:
 
 def write(path, record, meta: dict | None = None) -> Path:
     """Write a record (CGS, index t) as UFF (module docstring) in SI units."""
-    import pyuff
-
     path = Path(path)
     channels, values = for_writing(record)
     t = record.index.to_numpy(dtype=float)
