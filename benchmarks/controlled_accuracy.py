@@ -1,6 +1,7 @@
 """Accuracy against cost of the integration methods on 1 s runs across the operating range.
 
     python benchmarks/controlled_accuracy.py run /tmp/acc.json [--cases issue|range|all] [--tols 1e-4,1e-5]
+        [--max-segment-steps N]
     python benchmarks/controlled_accuracy.py table /tmp/acc.json
 
 Each case runs 1 s from the static equilibrium with a 0.5 s soft start and
@@ -12,6 +13,8 @@ the event log, ``regimes.contact_shares_of``), and the events in the
 window.  Methods: fixed RK4 at the default step, at a half and a quarter of
 it, and the controlled method at each tolerance, with its wall time, its
 lattice steps (accepted and in all) and its own largest error estimate.
+``--max-segment-steps`` caps the control interval (base steps; the
+default is ``methods.MAX_SEGMENT_STEPS``) to measure other interval lengths.
 ``table`` prints the saved results as Markdown, and for each tolerance the
 ratio of the run's global error estimate to its measured error (the larger
 of the tip's and the shares') over the cases whose converged solution is
@@ -94,7 +97,10 @@ def compare(run, ref):
             "event_err": abs(n - n_ref) / max(n_ref, 1)}
 
 
-def measure(name, params, ex, tols):
+def measure(name, params, ex, tols, max_segment_steps=None):
+    if max_segment_steps is not None:
+        from workbench.model import methods
+        methods.MAX_SEGMENT_STEPS = max_segment_steps
     dt = default_dt(params, ex)
     ref_run = simulate(params, ex, DURATION_S, dt=dt / CONVERGED_DIVISOR)
     half_ref = simulate(params, ex, DURATION_S, dt=dt / (CONVERGED_DIVISOR // 2))
@@ -124,6 +130,7 @@ def main(argv=None):
     ap.add_argument("--cases", choices=("issue", "range", "all"), default="issue")
     ap.add_argument("--tols", default="1e-4")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--max-segment-steps", type=int, default=None)
     args = ap.parse_args(argv)
     if args.what == "run":
         cases = {}
@@ -132,7 +139,7 @@ def main(argv=None):
         if args.cases in ("range", "all"):
             cases.update(range_cases())
         tols = [float(x) for x in args.tols.split(",")]
-        done = Parallel(n_jobs=args.jobs)(delayed(measure)(n, p, ex, tols)
+        done = Parallel(n_jobs=args.jobs)(delayed(measure)(n, p, ex, tols, args.max_segment_steps)
                                           for n, (p, ex) in cases.items())
         rows = [r for part in done for r in part]
         with open(args.file, "w") as f:
