@@ -40,12 +40,17 @@ SOURCES := $(shell find workbench -name "*.py" -not -path "*/__pycache__/*")
 study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, modes, identification, estimator)
 
 $(RESULTS)/index.md: $(foreach s,$(STUDIES),$(RESULTS)/$(s)/report.md) $(RESULTS)/modes/modes.md \
-		$(RESULTS)/identification/identification.md $(RESULTS)/estimate/estimate.md studies/index.py
-	$(PY) studies/index.py $(RESULTS) $(STUDIES) modes identification estimate
+		$(RESULTS)/identification/identification.md $(RESULTS)/estimate/estimate.md \
+		$(RESULTS)/paper/report.md studies/index.py
+	$(PY) studies/index.py $(RESULTS) $(STUDIES) modes identification estimate paper
 
 # Exit status 3: the sweep finished but some points failed; they are listed in the report.
 $(RESULTS)/%/report.md: studies/%.toml $(SOURCES) $(STAMP)
 	$(PY) -m workbench sweep $< --results $(RESULTS) || [ $$? -eq 3 ]
+
+# The paper's section 6 observations measured in the model, each with a verdict.
+$(RESULTS)/paper/report.md: $(STAMP) studies/paper.py $(SOURCES)
+	$(PY) studies/paper.py --out $(RESULTS)/paper
 
 # The paper's operating range driven hard (MODEL.md §5-§7): not part of `make study`.
 STRESS := stress stress_paper stress_chirp

@@ -53,3 +53,28 @@ def test_resonance_bands_are_found_at_their_known_times():
     assert len(bands) == 3
     assert bands == pytest.approx([50.0, 100.0, 180.0], abs=O.BAND_WINDOW_S)
     assert len(O.resonance_bands(t, np.sin(2 * np.pi * 5 * t))) == 0
+
+
+def test_the_verdicts_follow_their_rules():
+    """A sine record with the drive line, a subharmonic, peaks at 62 and 104 Hz and nothing
+    above 200 Hz, switching between 14 and 23 and never in 13; and a chirp record whose
+    bands sit at two of the paper's three times."""
+    t, noise = _record()
+    tone = lambda f, a: a * np.sin(2 * np.pi * f * t)          # noqa: E731
+    x = tone(20, 1.0) + tone(10, 0.01) + tone(62, 0.01) + tone(104, 0.01) + noise
+    v = O.assess_sine(t, x, {14: 0.3, 23: 0.45, 13: 0.0}, 900.0)
+    assert {k: verdict for k, (_, verdict) in v.items()} == {
+        "drive_line": "reproduced", "subharmonic": "reproduced", "peaks_60_100": "reproduced",
+        "above_200": "reproduced", "switch_14_23": "reproduced", "code_13": "not",
+        "switch_rate": "no number"}
+    assert "62.0 Hz" in v["peaks_60_100"][0] and "104.0 Hz" in v["peaks_60_100"][0]
+    v = O.assess_sine(t, tone(20, 1.0) + tone(300, 0.5) + noise, {14: 0.5, 23: 0.1}, 10.0)
+    assert v["subharmonic"][1] == "not" and v["above_200"][1] == "not"
+    assert v["switch_14_23"][1] == "partly"
+    fs = 200.0
+    tc = np.arange(int(240 * fs)) / fs
+    envelope = 1 + sum(2 * np.exp(-0.5 * ((tc - c) / 4.0) ** 2) for c in (50.0, 100.0))
+    verdicts, bands = O.assess_chirp(tc, envelope * np.sin(2 * np.pi * 20 * tc), 20.0)
+    words, verdict = verdicts["chirp_bands"]
+    assert bands == pytest.approx([50 / 60, 100 / 60], abs=O.BAND_WINDOW_S / 60)
+    assert verdict == "partly" and "2 of the paper's 3" in words

@@ -1,4 +1,9 @@
-"""The rules that measure the paper's §6 observations in a record, stated once.
+"""The paper's §6 observations as data, and the rules that measure them in a record.
+
+:data:`OBSERVATIONS` lists each observation with its section, figures and
+the paper's claim in our words; :func:`assess_sine` and :func:`assess_chirp`
+measure them in a run and give each a verdict ("reproduced", "partly",
+"not", or "no number" where the paper gives nothing to compare with).
 
 Each rule takes a signal sampled uniformly (an alias-free record: a run's
 signals or a lab file) and returns numbers; :data:`RULES` says each rule in
@@ -36,8 +41,27 @@ FLOOR_GAP = 3
 BAND_WINDOW_S = 2.0
 BAND_CONTEXT_S = 60.0
 BAND_MARGIN_DB = 3.0
+#: The paper's drive line, subharmonic and higher peaks (§6, Fig. 7-8), the share above which a
+#: band "has information", the bands of its chirp (Fig. 11-12, minutes) and how near a band must be.
+DRIVE_HZ = 20.0
+SUBHARMONIC_HZ = 10.0
+PEAK_BANDS_HZ = ((45.0, 75.0), (80.0, 120.0))
+HIGH_HZ = 200.0
+HIGH_SHARE = 0.01
+PAPER_BANDS_MIN = (0.83, 1.667, 3.0)
+BAND_MATCH_MIN = 0.25
+#: A contact code "dominates" above this share; a code "appears" above the second.
+DOMINANT_SHARE = 0.2
+APPEARS_SHARE = 0.01
+
 
 RULES = {
+    "verdicts": f"a code dominates above a share of {DOMINANT_SHARE:g} (14 and 23 both: "
+                f"reproduced) and appears above {APPEARS_SHARE:g}; the peaks near 60 and 100 Hz "
+                f"are the strongest in {PEAK_BANDS_HZ[0][0]:g}-{PEAK_BANDS_HZ[0][1]:g} and "
+                f"{PEAK_BANDS_HZ[1][0]:g}-{PEAK_BANDS_HZ[1][1]:g} Hz, each found at the line margin; "
+                f"'no information above 200 Hz' is less than {HIGH_SHARE:.0%} of the power there; "
+                f"a paper band is matched by a band within {BAND_MATCH_MIN:g} min",
     "line": f"a line is present when its Welch power (Hann, half overlap) stands "
             f"{LINE_MARGIN_DB:g} dB above the median of the bins within ±{FLOOR_BAND:.0%} of "
             f"its frequency (±{FLOOR_GAP} bins around it left out)",
@@ -109,3 +133,62 @@ def resonance_bands(t, x, skip_s: float = 0.0) -> list[float]:
     labels, count = ndimage.label(above)
     return [float(np.average(centre[labels == i], weights=power[labels == i]))
             for i in range(1, count + 1)]
+
+
+# --- the observations ----------------------------------------------------------------------
+
+OBSERVATIONS = (
+    {"id": "drive_line", "section": "§6", "figures": "Fig. 6-8",
+     "claim": "the driving frequency (20 Hz) stands out in the strain and dominates the time history"},
+    {"id": "subharmonic", "section": "§6", "figures": "Fig. 7-8",
+     "claim": "a subharmonic at 10 Hz in the strain spectrum, in experiment and simulation"},
+    {"id": "peaks_60_100", "section": "§6", "figures": "Fig. 7-8",
+     "claim": "higher peaks near 60 and 100 Hz (the simulation's a little higher than the experiment's)"},
+    {"id": "above_200", "section": "§6", "figures": "Fig. 8",
+     "claim": "none of the information above 200 Hz is present in the paper's simulation"},
+    {"id": "switch_14_23", "section": "§6", "figures": "Fig. 9",
+     "claim": "the simulation switches mostly between contact at 1 and 4 and at 2 and 3"},
+    {"id": "code_13", "section": "§6", "figures": "Fig. 10",
+     "claim": "the experiment also shows contact at 1 and 3"},
+    {"id": "switch_rate", "section": "§6", "figures": "Fig. 9-10",
+     "claim": "the switching rates of simulation and experiment differ (no numbers given)"},
+    {"id": "chirp_bands", "section": "§6", "figures": "Fig. 11-12",
+     "claim": "bands of resonance near 0.83, 1.67 and 3 minutes of the 5-65 Hz, 4-minute chirp"},
+)
+
+
+def _verdict(ok: bool) -> str:
+    return "reproduced" if ok else "not"
+
+
+def assess_sine(t, strain1, shares: dict, switches_per_s: float) -> dict:
+    """The observations of a 20 Hz sine run: {id: (measure in words, verdict)}."""
+    drive = line_level(t, strain1, DRIVE_HZ)
+    sub = line_level(t, strain1, SUBHARMONIC_HZ)
+    peaks = [strongest_peak(t, strain1, lo, hi) for lo, hi in PEAK_BANDS_HZ]
+    found = [p for p in peaks if p["level_db"] >= LINE_MARGIN_DB]
+    high = power_above(t, strain1, HIGH_HZ)
+    s14, s23, s13 = (shares.get(c, 0.0) for c in (14, 23, 13))
+    both = s14 >= DOMINANT_SHARE and s23 >= DOMINANT_SHARE
+    return {
+        "drive_line": (f"20 Hz line {drive['level_db']:.1f} dB over its floor", _verdict(drive["present"])),
+        "subharmonic": (f"10 Hz line {sub['level_db']:.1f} dB over its floor", _verdict(sub["present"])),
+        "peaks_60_100": ("; ".join(f"{p['f_hz']:.1f} Hz at {p['level_db']:.1f} dB" for p in peaks),
+                         "reproduced" if len(found) == 2 else ("partly" if found else "not")),
+        "above_200": (f"{high:.2%} of the strain's power above 200 Hz", _verdict(high < HIGH_SHARE)),
+        "switch_14_23": (f"shares 14: {s14:.2f}, 23: {s23:.2f}",
+                         "reproduced" if both else ("partly" if max(s14, s23) >= DOMINANT_SHARE else "not")),
+        "code_13": (f"share 13: {s13:.3f}", _verdict(s13 >= APPEARS_SHARE)),
+        "switch_rate": (f"{switches_per_s:.0f} switches per s", "no number"),
+    }
+
+
+def assess_chirp(t, strain1, skip_s: float) -> dict:
+    """The chirp's bands: {"chirp_bands": (measure in words, verdict)} and the band times (min)."""
+    bands = [b / 60.0 for b in resonance_bands(t, strain1, skip_s)]
+    matched = [p for p in PAPER_BANDS_MIN if any(abs(b - p) <= BAND_MATCH_MIN for b in bands)]
+    verdict = ("reproduced" if len(matched) == len(PAPER_BANDS_MIN)
+               else "partly" if matched else "not")
+    words = (f"bands at {', '.join(f'{b:.2f}' for b in bands) or 'none'} min; "
+             f"{len(matched)} of the paper's 3 within {BAND_MATCH_MIN:g} min")
+    return {"chirp_bands": (words, verdict)}, bands

@@ -12,7 +12,9 @@ with ``tip_limit_cm`` in [study] does it by a stated rule, for drives with a for
    force between changes of contact), at most LEVEL_RUNS runs in all; the last run is kept,
    and ``level_met`` says whether it met the level.
 
-The point's row keeps ``force_n_used`` (N), ``level_runs`` and ``level_met``.
+The point's row keeps ``force_n_used`` (N), ``level_runs`` and ``level_met``.  The same
+rule limits any other peak (:func:`accel_peak_g`: the accelerometers' range, as the paper's
+operator kept the sensors from saturating).
 """
 from __future__ import annotations
 
@@ -30,17 +32,26 @@ def tip_peak_cm(run) -> float:
     return float(np.nanmax(np.abs(run.signals.tip_y.to_numpy() - run.static_tip_y)))
 
 
-def limited_run(simulate_at: Callable[[float], object], force_n: float, limit_cm: float):
-    """The run (``simulate_at(force)``) whose tip stays within ``limit_cm`` by the rule of the
-    module docstring, starting from ``force_n``.  Returns (run, force used, runs, met)."""
+def accel_peak_g(run) -> float:
+    """The largest |acceleration| of accel1-3 (g) over the run: what saturates a sensor."""
+    from .metrics import G_CM_S2
+    return float(max(np.abs(run.signals[c].to_numpy()).max()
+                     for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
+
+
+def limited_run(simulate_at: Callable[[float], object], force_n: float, limit: float,
+                peak: Callable[[object], float] = tip_peak_cm):
+    """The run (``simulate_at(force)``) whose ``peak`` (default the tip's, cm) stays within
+    ``limit`` by the rule of the module docstring, starting from ``force_n``.  Returns (run,
+    force used, runs, met)."""
     force = force_n
     for runs in range(1, LEVEL_RUNS + 1):
         run = simulate_at(force)
         if not run.ok:
             return run, force, runs, False
-        peak = tip_peak_cm(run)
-        if peak <= limit_cm:
+        value = peak(run)
+        if value <= limit:
             return run, force, runs, True
         if runs < LEVEL_RUNS:
-            force = force * LEVEL_MARGIN * limit_cm / peak
+            force = force * LEVEL_MARGIN * limit / value
     return run, force, LEVEL_RUNS, False
