@@ -243,13 +243,6 @@ def peak_table(tables: dict[str, pd.DataFrame], responses, f_min: float = 0.0,
     return pd.concat(rows, ignore_index=True)[columns] if rows else pd.DataFrame(columns=columns)
 
 
-def segment_for(record: pd.DataFrame, segment_s: float = DEFAULT_SEGMENT_S,
-                n_segments: int = 4) -> float:
-    """``segment_s``, shortened so that the record holds at least ``n_segments`` (s)."""
-    t = record.index.to_numpy(dtype=float)
-    return min(segment_s, (t[-1] - t[0]) / n_segments)
-
-
 def responses_of(table: pd.DataFrame) -> list[str]:
     """The response channels of an FRF table."""
     return sorted({c.rsplit("_", 1)[0] for c in table.columns})

@@ -16,7 +16,7 @@ from ..experiments.channels import kind
 from ..experiments.compare import (DEFAULT_THRESHOLD_V, SIGNALS, Comparison, code_series,
                                    contact_differences, peak_shifts, signal_differences, window)
 from ..experiments.files import record_from_run
-from ..experiments.frf import frf, peak_table, segment_for
+from ..experiments.frf import default_window, frf, peak_table
 from ..model.params import ParameterError
 from . import figures as F
 
@@ -50,8 +50,8 @@ def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
     responses = [c for c in channels if kind(c) in ("accel", "strain")]
     if chirp and "force1" in rec_w.columns and responses:
         try:
-            seg = segment_for(rec_w)
-            tables = {name: frf(rec, responses, segment_s=seg) for name, rec in sources.items()}
+            tables = {name: frf(rec, responses, segment_s=None, window=default_window("chirp"))
+                      for name, rec in sources.items()}
         except ParameterError as exc:
             result.notes.append(f"FRFs not computed: {exc}")
         else:

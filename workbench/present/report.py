@@ -11,7 +11,8 @@ gap_mm and freq_hz axes, the shares and the bifurcation diagram need a
 sine drive over several frequencies; every point with a saved time series
 gets a time history, strain spectra and a switching diagram, and a chirp a
 spectrogram and its FRFs (H1 and coherence of every acceleration and strain
-against force1, :mod:`workbench.experiments.frf`) as well, with their peaks
+against force1 over one record-long rectangular window, the chirp's,
+:mod:`workbench.experiments.frf`) as well, with their peaks
 in ``tables/frf_peaks.{csv,md}``.
 """
 from __future__ import annotations
@@ -30,7 +31,7 @@ from ..model import drives
 from ..study.definition import Study
 from .tables import write_frf_peaks, write_tables
 from ..experiments.channels import CHANNELS, kind
-from ..experiments.frf import frf, peak_table, segment_for
+from ..experiments.frf import default_window, frf, peak_table
 
 #: The channels whose FRF against force1 a chirp's report shows.
 RESPONSES = tuple(c for c in CHANNELS if kind(c) in ("accel", "strain"))
@@ -73,7 +74,7 @@ def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
         yield f"spectrogram_{tag}", lambda: F.spectrogram(sig, title)
         responses = [c for c in sig.columns if c in RESPONSES]
         f_lo, f_hi = drives.band_hz(study.excitation)
-        tables = {title: frf(sig, responses, segment_s=segment_for(sig))}
+        tables = {title: frf(sig, responses, segment_s=None, window=default_window("chirp"))}
         frf_peaks.append(peak_table(tables, responses, f_lo, f_hi))
         yield f"frf_{tag}", lambda: F.frf_figure(tables[title], responses,
                                                  f"{title}: H1, H2, coherence against force1",
