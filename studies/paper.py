@@ -29,7 +29,8 @@ from workbench.model.regimes import contact_shares_of
 from workbench.present import figures as F
 from workbench.present import observations as O
 from workbench.present.tables import latex_text
-from workbench.study.leveling import accel_peak_g, limited_run
+from workbench.study.leveling import limited_run
+from workbench.study.metrics import accel_peak_g
 from workbench.study.provenance import environment
 
 FORCE_N = 200.0

@@ -13,30 +13,18 @@ with ``tip_limit_cm`` in [study] does it by a stated rule, for drives with a for
    and ``level_met`` says whether it met the level.
 
 The point's row keeps ``force_n_used`` (N), ``level_runs`` and ``level_met``.  The same
-rule limits any other peak (:func:`accel_peak_g`: the accelerometers' range, as the paper's
+rule limits any other peak (``metrics.accel_peak_g``: the accelerometers' range, as the paper's
 operator kept the sensors from saturating).
 """
 from __future__ import annotations
 
 from typing import Callable
 
-import numpy as np
+from .metrics import tip_peak_cm
 
 #: The runs a point may take to meet its level, and the margin below the level aimed at.
 LEVEL_RUNS = 5
 LEVEL_MARGIN = 0.97
-
-
-def tip_peak_cm(run) -> float:
-    """The tip's largest deflection (cm) from its static equilibrium over the run."""
-    return float(np.nanmax(np.abs(run.signals.tip_y.to_numpy() - run.static_tip_y)))
-
-
-def accel_peak_g(run) -> float:
-    """The largest |acceleration| of accel1-3 (g) over the run: what saturates a sensor."""
-    from .metrics import G_CM_S2
-    return float(max(np.abs(run.signals[c].to_numpy()).max()
-                     for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
 
 
 def limited_run(simulate_at: Callable[[float], object], force_n: float, limit: float,

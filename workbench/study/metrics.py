@@ -138,15 +138,25 @@ G_CM_S2 = 980.665
 N_DYN = 1e5
 
 
+def tip_peak_cm(run) -> float:
+    """The tip's largest deflection (cm) from its static equilibrium over the run."""
+    return float(np.nanmax(np.abs(run.signals.tip_y.to_numpy() - run.static_tip_y)))
+
+
+def accel_peak_g(run) -> float:
+    """The largest |acceleration| of accel1-3 (g) over the run: what saturates a sensor."""
+    return float(max(np.abs(run.signals[c].to_numpy()).max()
+                     for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
+
+
 def validity(run) -> dict:
     """The run's largest responses against the range the model is validated for (module
     docstring)."""
     sig = run.signals
-    tip = float(np.nanmax(np.abs(sig.tip_y.to_numpy() - run.static_tip_y)))
+    tip = tip_peak_cm(run)
     slide = float(np.abs(sig.s.to_numpy()).max())
-    accel = float(max(np.abs(sig[c].to_numpy()).max() for c in ("accel1", "accel2", "accel3")))
     force = float(np.abs(sig.force1.to_numpy()).max())
-    out = {"tip_abs_max_cm": tip, "slide_abs_max_cm": slide, "accel_abs_max_g": accel / G_CM_S2,
+    out = {"tip_abs_max_cm": tip, "slide_abs_max_cm": slide, "accel_abs_max_g": accel_peak_g(run),
            "force1_abs_max_n": force / N_DYN}
     over = [name for name, value, limit in (
         ("tip", tip, VALID_TIP_CM), ("slot", slide, run.params.s_travel),
