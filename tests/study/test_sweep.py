@@ -448,3 +448,21 @@ def test_a_relative_results_folder_is_the_callers_whatever_the_workers_cwd(tmp_p
         table = W.sweep(write(tmp_path, text), "res", jobs=2, progress=False)
         assert table.status.tolist() == ["ok", "ok"]
         assert len(list((tmp_path / folder / "res" / "small" / "points").glob("*.parquet"))) == 2
+
+
+def test_a_checked_study_keeps_each_points_measured_error_and_reports_it(tmp_path):
+    text = SMALL.replace('name = "small"', 'name = "checked"\ncheck_accuracy = true').replace(
+        "gap_mm = [0.508, 1.016]", "gap_mm = [1.016]").replace("save_series = [{gap_mm = 1.016, freq_hz = 20.0}]\n", "")
+    study = S.load(write(tmp_path, text))
+    assert study.check_accuracy
+    table = W.run_study(study, tmp_path / "res", jobs=1, progress=False)
+    assert (table.status == "ok").all() and table.error_measured.notna().all()
+    assert (table.error_measured == table[["tip_error_measured", "share_error_measured"]].max(axis=1)).all()
+    from workbench.present.report import accuracy_lines
+    text = "\n".join(accuracy_lines(study, table))
+    assert f"largest error (the tip's of its range, or a contact share's) is " \
+           f"{table.error_measured.max():.2g}" in text and "every one is within 0.001" in text
+    over = table.assign(error_measured=[2e-3, 1e-6])
+    assert "1 exceed 0.001" in "\n".join(accuracy_lines(study, over))
+    plain = "\n".join(accuracy_lines(study, table.drop(columns=["error_measured"])))
+    assert "No point was checked against a companion run" in plain

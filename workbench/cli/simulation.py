@@ -103,8 +103,9 @@ def _cmd_run(args) -> int:
         meta = settings_of(drive, p)
         files.check_settings(args.out, meta)
     run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
-                   method=args.method, tol=args.tol, initial=args.initial, progress=not args.json and sys.stderr.isatty(),
-                   **start)
+                   method=args.method, tol=args.tol, initial=args.initial,
+                   progress=not args.json and sys.stderr.isatty(),
+                   check_accuracy=args.check_accuracy, **start)
     if args.out:
         if files.format_of(args.out) == "parquet":       # the whole run: every signal, events
             run.signals.attrs["meta"] = meta
@@ -165,6 +166,9 @@ def add_parsers(sub) -> None:
                      "docs/model.md 'Integration')")
     run.add_argument("--output-hz", type=number(0, MAX_OUTPUT_HZ, lo_open=True), default=None,
                      help="sample rate of the signals (Hz; default 1000, a hammer's 10 samples a pulse)")
+    run.add_argument("--check-accuracy", action="store_true",
+                     help="also run a companion at a tenth of --tol (or a quarter of --dt) and "
+                     "report the error measured against it (error_measured)")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")
     run.add_argument("--out", metavar="FILE", help="write the signals, in the format of the suffix: "

@@ -24,7 +24,7 @@ import numpy as np
 
 from . import packing as mdl
 from ..core import excitation as cx, layout as ly
-from . import antialias, drives
+from . import accuracy, antialias, drives
 from .drives import none
 from .tableaus import write_tableau
 from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
@@ -290,7 +290,8 @@ class Run:
             {name: e[name].to_numpy() for name in ENERGY_COLUMNS})
         return e
 
-    def _sensor(self, name: str) -> np.ndarray:
+    def signal(self, name: str) -> np.ndarray:
+        """The samples of one signal of SIGNALS (its unit there), without building ``signals``."""
         return self.sensors[:, ly.SIGNALS.index(name)]
 
     def energy_balance_rel(self) -> float:
@@ -303,7 +304,7 @@ class Run:
         ENERGY_SCALE_FLOOR_ERG: a run that stays at rest divides its
         round-off residual by 1 erg, not by a near-zero throughput.
         """
-        c = {name: self._sensor(name) for name in ENERGY_COLUMNS}
+        c = {name: self.signal(name) for name in ENERGY_COLUMNS}
         total, residual = energy_account(c)
         last = {name: float(x[-1]) for name, x in c.items()}
         scale = (abs(last["w_excitation"]) + last["d_structural"] + last["d_cork"]
@@ -320,8 +321,8 @@ class Run:
         """Scalar results of the run (the ``workbench run --json`` object)."""
         kinds = self.log[:, ly.LOG_KIND]
         visited = (set(int(r) for r in self.log[:, ly.LOG_TO])
-                   | set(int(r) for r in self._sensor("regime")))
-        tip = self._sensor("tip_y") - self.static_tip_y
+                   | set(int(r) for r in self.signal("regime")))
+        tip = self.signal("tip_y") - self.static_tip_y
         return {
             "status": "ok" if self.ok else "failed",
             "status_code": self.status,
@@ -347,8 +348,8 @@ class Run:
             "energy_balance_rel": self.energy_balance_rel(),
             "impact_energy_lost_erg": float(self.stats["impact_energy_lost_erg"]),
             **{key: self.stats[key] for key in CONTACT_STAT_KEYS},
-            "strain1_rms": float(np.std(self._sensor("strain1"))),
-            "strain2_rms": float(np.std(self._sensor("strain2"))),
+            "strain1_rms": float(np.std(self.signal("strain1"))),
+            "strain2_rms": float(np.std(self.signal("strain2"))),
             "tip_disp_peak_cm": float(np.abs(tip).max()),
         }
 
@@ -402,7 +403,8 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
              dt: float | None = None, output_hz: float | None = None, initial="static",
              free_decay_cm: float | None = None, fixed=(), progress: bool = False,
              t0: float = 0.0, regime: int = 0, method: str | None = None,
-             tol: float | None = None, level_max: int = DEFAULT_LEVEL_MAX) -> Run:
+             tol: float | None = None, level_max: int = DEFAULT_LEVEL_MAX,
+             check_accuracy: bool = False) -> Run:
     """Simulate ``duration`` seconds of the loose-joint beam (docs/model.md §3-9).
 
     ``excitation`` is an array from :mod:`workbench.model.drives` (default: none).
@@ -418,8 +420,11 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     ``output_hz`` is the sample rate of the signals; 1 / (output_hz dt)
     must be a whole number.  By default limits.DEFAULT_OUTPUT_HZ, or for a hammer
     PULSE_SAMPLES samples a pulse (the next rate dividing 1 / dt).  ``fixed`` holds coordinates (tests, locked
-    joint).  Never raises on a failure of the integration: the run stops
-    with a status code and keeps what it computed.
+    joint).  ``check_accuracy`` runs a companion at finer settings (a tenth of
+    the tolerance, or a quarter of the step) and adds the run's error measured
+    against it to ``run.control`` (:mod:`workbench.model.accuracy`).  Never
+    raises on a failure of the integration: the run stops with a status code
+    and keeps what it computed.
     """
     if not isinstance(params, Parameters):
         raise ParameterError(f"params must be workbench.model.params.Parameters, got {type(params).__name__}")
@@ -521,6 +526,13 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     run.tol = tol
     run.control = (control_summary(controller[1], controller[3], tol, dt, duration) if controller
                    else fixed_step_summary(dt, int(st[ly.ST_STEP])))
+    if check_accuracy and run.ok:
+        finer = accuracy.companion_settings(METHODS[method].controlled, tol, dt)
+        companion = simulate(params, excitation, duration, output_hz=1.0 / (decim * dt),
+                             initial=initial, free_decay_cm=free_decay_cm, fixed=fixed, t0=t0,
+                             regime=regime, method=method, level_max=level_max,
+                             **{"dt": dt, "tol": tol, **finer})
+        run.control.update(accuracy.measured(run, companion, finer))
     return run
 
 

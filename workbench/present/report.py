@@ -28,6 +28,7 @@ from ..study.grid import point_slug, point_title
 from ..study.provenance import environment
 from ..study.store import read_runs, write_text_atomic
 from ..model import drives
+from ..model.accuracy import ERROR_BOUND
 from ..study.definition import Study
 from .tables import write_frf_peaks, write_tables
 from ..experiments.channels import CHANNELS, kind
@@ -197,6 +198,7 @@ def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
         lines[0] += (f" The largest global error estimate (the local estimates' root sum of "
                      f"squares, of a position's scale or a contact share) is "
                      f"{g.global_error_est:.2g} ({point_title(g)}).")
+    lines[0] += " " + measured_sentence(ok)
     over = ok[(ok.error_over_tol_max > 1.0) | (ok.floor_count > 0)]
     if len(over):
         lines += ["## Points above their tolerance", "",
@@ -207,6 +209,23 @@ def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
                   for _, r in over.iterrows()]
         lines.append("")
     return lines
+
+
+def measured_sentence(ok: pd.DataFrame) -> str:
+    """The errors measured against companion runs (``[study] check_accuracy``), or that none were."""
+    if "error_measured" not in ok or not ok.error_measured.notna().any():
+        return ("No point was checked against a companion run (`check_accuracy = true` "
+                "measures each point's error).")
+    checked = ok[ok.error_measured.notna()]
+    worst = checked.loc[checked.error_measured.idxmax()]
+    above = checked[checked.error_measured > ERROR_BOUND]
+    text = (f"Measured against a companion run at a tenth of the tolerance, the largest error "
+            f"(the tip's of its range, or a contact share's) is {worst.error_measured:.2g} "
+            f"({point_title(worst)}), over {len(checked)} points")
+    if len(above):
+        return text + (f"; {len(above)} exceed {ERROR_BOUND:g}: "
+                       + "; ".join(point_title(r) for _, r in above.iterrows()) + ".")
+    return text + f"; every one is within {ERROR_BOUND:g}."
 
 
 def range_lines(table: pd.DataFrame) -> list[str]:

@@ -10,6 +10,8 @@
     dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
                                      # controlled method's coarsest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
+    check_accuracy = true            # optional: each point also run at a tenth of tol (or a
+                                     # quarter of dt), its error measured against it (accuracy.py)
     tip_limit_cm = 5.0               # optional: a response-limited drive, each point's force the
                                      # largest up to force_n keeping the tip within it (leveling.py)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
@@ -53,7 +55,7 @@ from ..model.params import ParameterError, Parameters, check_positive, read_toml
 
 SWEEP_MODES = ("independent", "up", "down", "up-down")
 STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz", "tol",
-              "method", "tip_limit_cm", "save_series", "initial"}
+              "method", "tip_limit_cm", "save_series", "initial", "check_accuracy"}
 
 
 class StudyError(ParameterError):
@@ -106,6 +108,7 @@ class Study:
     method: str = "controlled"
     tol: float | None = None
     tip_limit_cm: float | None = None
+    check_accuracy: bool = False
     points: tuple = field(default=(), repr=False)
 
     @property
@@ -189,6 +192,12 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     tip_limit = head.get("tip_limit_cm")
     if tip_limit is not None:
         tip_limit = check_positive("[study] tip_limit_cm", tip_limit, "cm")
+    check_accuracy = head.get("check_accuracy", False)
+    if not isinstance(check_accuracy, bool):
+        raise StudyError(f"[study] check_accuracy = {_short(check_accuracy)} must be true or false")
+    if check_accuracy and method == "controlled":
+        from ..model.accuracy import companion_settings
+        companion_settings(True, tol, 0.0, name="[study] tol")
     initial = head.get("initial", "static")
     if initial not in ("static", "paper"):
         raise StudyError(f"[study] initial = {initial!r}; allowed: 'static', 'paper'")
@@ -281,7 +290,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
                  excitation={"drive": drive, **exc}, fixed=fixed, axes=axes, save_series=series,
                  source=source, points=tuple(points), method=method, tol=tol,
-                 tip_limit_cm=tip_limit)
+                 tip_limit_cm=tip_limit, check_accuracy=check_accuracy)
 
 
 def _short(value) -> str:

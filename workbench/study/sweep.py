@@ -48,7 +48,8 @@ WATCHDOG_S = 1.0
 STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
 #: The integrator's account kept in a point's row (Run.summary keys).
 CONTROL_KEYS = ("steps", "steps_all", "rejected", "h_min", "h_max", "error_est_max",
-                "error_over_tol_max", "global_error_est", "floor_count")
+                "error_over_tol_max", "global_error_est", "floor_count", "error_measured",
+                "tip_error_measured", "share_error_measured", "event_error_measured")
 
 
 def point_key(study: Study, point: Point, previous_key: str = "") -> str:
@@ -58,7 +59,7 @@ def point_key(study: Study, point: Point, previous_key: str = "") -> str:
         "first_in_chain": point.step == 0, "duration_s": study.duration_s,
         "window_s": study.window_s, "dt": study.dt, "output_hz": study.output_hz,
         "method": study.method, "tol": study.tol, "initial": study.initial, "previous": previous_key, "code": code_version(),
-        "tip_limit_cm": study.tip_limit_cm,
+        "tip_limit_cm": study.tip_limit_cm, "check_accuracy": study.check_accuracy,
     }
     text = json.dumps(record, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -88,7 +89,7 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
         row["energy_balance_rel"] = run.energy_balance_rel()
         row["method"] = run.method
         row["tol"] = run.tol
-        row.update({key: run.control[key] for key in CONTROL_KEYS})
+        row.update({key: run.control.get(key) for key in CONTROL_KEYS})
         row.update(contact_checks(run))
         row["static_tip_y"] = run.static_tip_y
         final = run.signals.iloc[-1]
@@ -102,20 +103,22 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> 
     t0 = time.perf_counter()
     continued = initial is not None
     try:
-        def simulate_at(force_n=None):
+        def simulate_at(force_n=None, check_accuracy=False):
             settings = point.excitation if force_n is None else {**point.excitation,
                                                                   "force_n": force_n}
             return simulate(point.params, excitation_array(settings, first_in_chain=not continued),
                             study.duration_s, dt=study.dt, output_hz=study.output_hz,
-                            method=study.method, tol=study.tol,
+                            method=study.method, tol=study.tol, check_accuracy=check_accuracy,
                             initial=initial if continued else study.initial, **point.start_keywords)
         if study.tip_limit_cm is None:
-            run = simulate_at()
+            run = simulate_at(check_accuracy=study.check_accuracy)
             level = {}
         else:
             run, force, runs, met = limited_run(simulate_at, point.excitation["force_n"],
                                                 study.tip_limit_cm)
             level = {"force_n_used": force, "level_runs": runs, "level_met": met}
+            if study.check_accuracy and run.ok:      # the same run again, with its companion
+                run = simulate_at(force, check_accuracy=True)
         metrics = {**level, **point_metrics(run, study.window_s, point.drive_hz)} if run.ok else level
         row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)
