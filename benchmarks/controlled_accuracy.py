@@ -17,9 +17,8 @@ lattice steps (accepted and in all) and its own largest error estimate.
 default is ``methods.MAX_SEGMENT_STEPS``) to measure other interval lengths.
 ``table`` prints the saved results as Markdown, and for each tolerance the
 ratio to the measured error (the larger of the tip's and the shares') of
-the run's global error estimate and of its difference from the run at a
-tenth of its tolerance (what ``check_accuracy`` measures; when both
-tolerances are run), over the cases whose converged solution is
+the run's global error estimate and of its difference from its companion
+run (what ``check_accuracy`` measures, here in the window), over the cases whose converged solution is
 converged (its own error below 1e-4 of the tip's range).
 """
 from __future__ import annotations
@@ -34,7 +33,7 @@ from joblib import Parallel, delayed
 from workbench.model.drives import chirp, sine
 from workbench.model.params import Parameters
 from workbench.model.simulate import default_dt, simulate
-from workbench.model.accuracy import TOL_DIVISOR, difference
+from workbench.model.accuracy import companion_settings, difference
 
 DURATION_S = 1.0
 RAMP_S = 0.5
@@ -98,13 +97,11 @@ def measure(name, params, ex, tols, max_segment_steps=None):
         run = simulate(params, ex, DURATION_S, dt=dt / d)
         rows.append({"case": name, "method": f"rk4 dt/{d}", "ok": run.ok, "wall_s": run.wall_s,
                      "steps": run.control["steps"], **compare(run, ref)})
-    runs = {tol: simulate(params, ex, DURATION_S, tol=tol) for tol in tols}
-    for tol, run in runs.items():
+    for tol in tols:
+        run = simulate(params, ex, DURATION_S, tol=tol)
         c = run.control
-        companion = next((r for t, r in runs.items() if abs(t * TOL_DIVISOR / tol - 1) < 1e-9),
-                         None)
-        by_companion = (None if companion is None else
-                        max(compare(run, companion)[k] for k in ("tip_err", "share_err")))
+        companion = simulate(params, ex, DURATION_S, **companion_settings(True, tol, dt))
+        by_companion = max(compare(run, companion)[k] for k in ("tip_err", "share_err"))
         rows.append({"case": name, "method": f"controlled {tol:g}", "ok": run.ok,
                      "wall_s": run.wall_s, "steps": c["steps"], "steps_all": c["steps_all"],
                      "rejected": c["rejected"], "h_min": c["h_min"],

@@ -43,10 +43,11 @@ def test_the_companion_measures_the_error_of_a_fixed_step_run():
     assert c["error_measured"] == max(c["tip_error_measured"], c["share_error_measured"])
 
 
-def test_the_controlled_run_is_checked_at_a_tenth_of_its_tolerance():
+def test_the_controlled_run_is_checked_at_a_tenth_of_its_tolerance_and_half_its_step():
     params, ex, duration = CASE
     run = simulate(params, ex, duration, tol=1e-4, check_accuracy=True)
     assert run.control["companion"]["tol"] == pytest.approx(1e-5)
+    assert run.control["companion"]["dt"] == default_dt(params, ex) / 2
     assert 0.0 < run.control["error_measured"] < accuracy.ERROR_BOUND
     assert run.summary()["error_measured"] == run.control["error_measured"]
     plain = simulate(params, ex, duration, tol=1e-4)

@@ -167,7 +167,8 @@ def add_parsers(sub) -> None:
     run.add_argument("--output-hz", type=number(0, MAX_OUTPUT_HZ, lo_open=True), default=None,
                      help="sample rate of the signals (Hz; default 1000, a hammer's 10 samples a pulse)")
     run.add_argument("--check-accuracy", action="store_true",
-                     help="also run a companion at a tenth of --tol (or a quarter of --dt) and "
+                     help="also run a companion at a tenth of --tol and half the step (or a quarter "
+                     "of a fixed --dt) and "
                      "report the error measured against it (error_measured)")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")

@@ -3,10 +3,13 @@
 The controlled method's ``global_error_est`` sums local estimates; it cannot
 see errors that the motion amplifies after they are made (docs/performance.md,
 "The estimate against the measured error").  A companion run measures them:
-the same input at a tenth of the tolerance (controlled) or a quarter of the
-step (RK4, fourth order: about 1/256 of the error), compared sample by sample
-with the run.  Since the companion's own error is small beside the run's, the
-difference is the run's error to within that fraction.
+the same input at a tenth of the tolerance and half the coarsest step
+(controlled; where the motion is smooth the controller keeps the coarsest
+step at any tolerance, and a tighter tolerance alone would repeat the run)
+or a quarter of the step (RK4, fourth order: about 1/256 of the error),
+compared sample by sample with the run.  Since the companion's own error
+is small beside the run's, the difference is the run's error to within
+that fraction.
 
 Measures (the bounds docs/performance.md holds every default run to):
 
@@ -31,8 +34,10 @@ from .regimes import contact_shares_of
 
 #: The companion's tolerance is the run's divided by this (controlled method).
 TOL_DIVISOR = 10
-#: The companion's step is the run's divided by this (fixed-step methods).
+#: The companion's step is the run's divided by this (fixed-step methods) ...
 DT_DIVISOR = 4
+#: ... and its coarsest step (controlled method).
+COARSEST_DIVISOR = 2
 #: The accuracy every default run is held to: the tip within this fraction of its
 #: range, every contact share within this (docs/performance.md, "Accuracy").
 ERROR_BOUND = 1e-3
@@ -43,7 +48,8 @@ KEYS = ("error_measured", "tip_error_measured", "share_error_measured",
 
 def companion_settings(method_controlled: bool, tol: float | None, dt: float,
                        name: str = "tol") -> dict:
-    """The finer settings of the companion run: ``{"tol": tol / 10}`` or ``{"dt": dt / 4}``.
+    """The finer settings of the companion run of a run of step ``dt`` (s; the coarsest of
+    a controlled run): ``{"tol": tol / 10, "dt": dt / 2}`` or ``{"dt": dt / 4}``.
 
     A tolerance already at the lower end of TOL_RANGE cannot be divided;
     ParameterError says so, naming the tolerance as ``name``.
@@ -54,7 +60,7 @@ def companion_settings(method_controlled: bool, tol: float | None, dt: float,
     if finer < TOL_RANGE[0]:
         raise ParameterError(f"{name} = {tol:g} leaves no room for a companion at tol / {TOL_DIVISOR} "
                          f"(the smallest tolerance is {TOL_RANGE[0]:g})")
-    return {"tol": finer}
+    return {"tol": finer, "dt": dt / COARSEST_DIVISOR}
 
 
 def difference(run, ref, t0: float | None = None, t1: float | None = None) -> dict:

@@ -421,7 +421,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     must be a whole number.  By default limits.DEFAULT_OUTPUT_HZ, or for a hammer
     PULSE_SAMPLES samples a pulse (the next rate dividing 1 / dt).  ``fixed`` holds coordinates (tests, locked
     joint).  ``check_accuracy`` runs a companion at finer settings (a tenth of
-    the tolerance, or a quarter of the step) and adds the run's error measured
+    the tolerance and half the coarsest step, or a quarter of a fixed step) and adds the run's error measured
     against it to ``run.control`` (:mod:`workbench.model.accuracy`).  Never
     raises on a failure of the integration: the run stops with a status code
     and keeps what it computed.

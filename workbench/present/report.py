@@ -219,7 +219,8 @@ def measured_sentence(ok: pd.DataFrame) -> str:
     checked = ok[ok.error_measured.notna()]
     worst = checked.loc[checked.error_measured.idxmax()]
     above = checked[checked.error_measured > ERROR_BOUND]
-    text = (f"Measured against a companion run at a tenth of the tolerance, the largest error "
+    text = (f"Measured against a companion run (a tenth of the tolerance, half the step), "
+            f"the largest error "
             f"(the tip's of its range, or a contact share's) is {worst.error_measured:.2g} "
             f"({point_title(worst)}), over {len(checked)} points")
     if len(above):

@@ -10,8 +10,8 @@
     dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
                                      # controlled method's coarsest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
-    check_accuracy = true            # optional: each point also run at a tenth of tol (or a
-                                     # quarter of dt), its error measured against it (accuracy.py)
+    check_accuracy = true            # optional: each point also run at a tenth of tol and half
+                                     # the step (a quarter of a fixed dt), its error measured against it (accuracy.py)
     tip_limit_cm = 5.0               # optional: a response-limited drive, each point's force the
                                      # largest up to force_n keeping the tip within it (leveling.py)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
