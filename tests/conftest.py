@@ -41,9 +41,12 @@ def params(request):
 def pytest_sessionfinish(session, exitstatus):
     """Fail the run if a kernel was compiled in more than one version
     (a literal or omitted argument, or a test passing other types;
-    tests/core/test_compile.py)."""
-    from workbench.core._cache import kernel_versions
+    tests/core/test_compile.py): in this process, and when the suite ran in
+    worker processes (``pytest -n``), in the cache they all wrote."""
+    from workbench.core._cache import index_entries, kernel_versions
     extra = {k: n for k, n in kernel_versions().items() if n > 1}
+    if not hasattr(session.config, "workerinput"):          # not a worker: the whole run
+        extra.update({k: n for k, n in index_entries().items() if n > 1})
     if extra:
         print(f"\nkernels compiled in more than one version: {extra}", file=sys.stderr)
         session.exitstatus = 1
