@@ -33,11 +33,9 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from ..study.metrics import psd
+from ..study.metrics import (FLOOR_BAND, FLOOR_GAP, LINE_MARGIN_DB, line_level,  # noqa: F401
+                             sample_rate, spectrum)
 
-LINE_MARGIN_DB = 10.0
-FLOOR_BAND = 0.5
-FLOOR_GAP = 3
 BAND_WINDOW_S = 2.0
 BAND_CONTEXT_S = 60.0
 BAND_MARGIN_DB = 3.0
@@ -73,33 +71,6 @@ RULES = {
 }
 
 
-def _rate(t: np.ndarray) -> float:
-    dt = np.diff(t)
-    if len(t) < 16 or not np.allclose(dt, dt[0], rtol=1e-6):
-        raise ValueError("the signal needs at least 16 uniform samples")
-    return 1.0 / dt[0]
-
-
-def spectrum(t, x, resolution_hz: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
-    """Welch's power spectral density of x about its mean (``metrics.psd``): Hz, PSD."""
-    _rate(t)
-    return psd(t, x, segment_s=1.0 / resolution_hz)
-
-
-def line_level(t, x, f_hz: float, resolution_hz: float = 0.5) -> dict:
-    """The line at ``f_hz``: its power, its level over the floor (dB), and present or not."""
-    f, p = spectrum(t, x, resolution_hz)
-    df = f[1] - f[0]
-    k = int(round(f_hz / df))
-    near = slice(max(0, k - 1), k + 2)
-    power = float(p[near].max())
-    band = (np.abs(f - f_hz) <= FLOOR_BAND * f_hz) & (np.abs(np.arange(len(f)) - k) > FLOOR_GAP)
-    floor = float(np.median(p[band])) if band.any() else float("nan")
-    level = 10.0 * np.log10(power / floor) if floor > 0 else float("inf")
-    return {"f_hz": f_hz, "power": power, "floor": floor, "level_db": float(level),
-            "present": bool(level >= LINE_MARGIN_DB)}
-
-
 def strongest_peak(t, x, lo_hz: float, hi_hz: float, resolution_hz: float = 0.5) -> dict:
     """The strongest spectral peak within [lo_hz, hi_hz] and its level over the band (dB)."""
     f, p = spectrum(t, x, resolution_hz)
@@ -118,7 +89,7 @@ def power_above(t, x, f_hz: float, resolution_hz: float = 0.5) -> float:
 
 def resonance_bands(t, x, skip_s: float = 0.0) -> list[float]:
     """The times (s) of the bands of resonance of a swept record (module docstring)."""
-    fs = _rate(t)
+    fs = sample_rate(t)
     n = int(round(BAND_WINDOW_S * fs))
     windows = len(x) // n
     if windows < 3:

@@ -130,6 +130,9 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
     The figures are drawn by ``jobs`` processes (joblib), a grid figure or
     one point's series per task.
     """
+    if study.sample is not None:
+        from .sensitivity import make_sensitivity_report
+        return make_sensitivity_report(study, results)
     out = Path(results).resolve() / study.name      # absolute: worker processes keep their own cwd
     table = pd.read_parquet(out / "points.parquet")
     t0 = time.perf_counter()

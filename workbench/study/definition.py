@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 
 from ..model import drives
+from . import sensitivity
 from ..model.limits import MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
@@ -109,6 +110,7 @@ class Study:
     tol: float | None = None
     tip_limit_cm: float | None = None
     check_accuracy: bool = False
+    sample: sensitivity.Sample | None = None
     points: tuple = field(default=(), repr=False)
 
     @property
@@ -149,10 +151,12 @@ def load(path: str | Path) -> Study:
 
 def from_dict(data: dict[str, Any], source: str = "") -> Study:
     """A Study from the parsed TOML tables (see the module docstring)."""
-    unknown = sorted(set(data) - {"study", "excitation", "fixed", "axes"})
+    tables = ("study", "excitation", "fixed", "axes", "sample", "ranges")
+    unknown = sorted(set(data) - set(tables))
     if unknown:
-        raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [fixed], [axes]")
-    for table in ("study", "excitation", "fixed", "axes"):
+        raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [fixed], "
+                         "[axes], or [sample] with [ranges]")
+    for table in tables:
         if table in data and not isinstance(data[table], dict):
             raise StudyError(f"[{table}] must be a table of keys, got {_short(data[table])}")
     head = dict(data.get("study", {}))
@@ -208,6 +212,17 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         raise StudyError(f"[excitation] drive = {drive!r}; allowed: {sorted(drives.DRIVES)}")
     fixed = dict(data.get("fixed", {}))
     axes = dict(data.get("axes", {}))
+    sample = None
+    if "sample" in data or "ranges" in data:
+        if axes:
+            raise StudyError("a study has [axes] (a grid) or [sample] with [ranges] (a design), "
+                             "not both")
+        if "sample" not in data:
+            raise StudyError("[ranges] needs a [sample] table (n, seed) to draw the design")
+        if sweep != "independent":
+            raise StudyError(f"[study] sweep = {sweep!r} steps a grid's frequency axis; a "
+                             "[sample] design runs independent points")
+        sample = sensitivity.parse(data["sample"], data.get("ranges", {}), StudyError)
     for key, values in axes.items():
         if not isinstance(values, list) or not values:
             raise StudyError(f"[axes] {key} must be a non-empty list of values, got {_short(values)}")
@@ -223,7 +238,9 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
             table = "excitation" if key in exc else "fixed"
             raise StudyError(f"[{table}] {key} must be a number, true/false or a string, "
                              f"got {_short(value)}")
-    for table, keys in (("excitation", exc), ("axes", axes), ("fixed", fixed)):
+    inputs = {} if sample is None else {k: None for k in [*sample.names, *sample.same]}
+    for table, keys in (("excitation", exc), ("axes", axes), ("fixed", fixed),
+                        ("ranges", inputs)):
         for key in keys:
             if key in allowed_exc:
                 if table == "fixed":
@@ -237,10 +254,10 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                 raise StudyError(f"[excitation] unknown key {key!r}; a {drive!r} excitation "
                                  f"takes {sorted(allowed_exc)}")
             resolve_name(key)                      # raises, with a suggestion, if unknown
-    both = sorted(set(axes) & (set(fixed) | set(exc)))
+    both = sorted((set(axes) | set(inputs)) & (set(fixed) | set(exc)))
     if both:
         raise StudyError(f"{both} given both as an axis and as a fixed value")
-    missing = sorted(k for k in allowed_exc - set(exc) - set(axes)
+    missing = sorted(k for k in allowed_exc - set(exc) - set(axes) - set(inputs)
                      if drives.DRIVES[drive].default(k) is None)
     if missing:
         raise StudyError(f"a {drive!r} excitation needs {missing} in [excitation] or [axes]")
@@ -256,15 +273,23 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     where = {"duration": "[study] duration_s", "dt": "[study] dt", "output_hz": "[study] output_hz"}
     for k in allowed_exc:
         where[k] = f"[axes] {k}" if k in axes else f"[excitation] {k}"
+    for k in allowed_exc:
+        if k in inputs:
+            where[k] = f"[ranges] {k}"
     points = []
-    for combo in itertools.product(*(axes[n] for n in names)):
-        values = dict(zip(names, combo))
-        model_values = {**fixed, **{k: v for k, v in values.items() if k not in allowed_exc}}
+    for values, factors in _combinations(axes, sample):
         try:
-            params = Parameters.from_user(model_values)
+            model_values = {**fixed, **{k: v for k, v in values.items() if k not in allowed_exc}}
             settings = {"drive": drive}
             for k in drives.DRIVES[drive].keys:
                 settings[k] = values.get(k, exc.get(k, drives.DRIVES[drive].default(k, duration)))
+            for k, factor in factors.items():      # a factor of the point's own value
+                if k in allowed_exc:
+                    settings[k] = values[k] = factor * settings[k]
+                else:
+                    base = own_value(Parameters.from_user(model_values), k)
+                    model_values[k] = values[k] = factor * base
+            params = Parameters.from_user(model_values)
             pt = Point(values=values, params=params, excitation=settings)
             _check_point(pt, duration, dt, output_hz, where)
         except StudyError:
@@ -290,7 +315,35 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
                  excitation={"drive": drive, **exc}, fixed=fixed, axes=axes, save_series=series,
                  source=source, points=tuple(points), method=method, tol=tol,
-                 tip_limit_cm=tip_limit, check_accuracy=check_accuracy)
+                 tip_limit_cm=tip_limit, check_accuracy=check_accuracy, sample=sample)
+
+
+def _combinations(axes: dict, sample) -> list[tuple[dict, dict]]:
+    """Each point's (values, factors): the grid's combinations of the axes in order, or the
+    design's rows in order ([sample]; factors of "times" inputs, "same" inputs copied)."""
+    if sample is None:
+        names = list(axes)
+        return [(dict(zip(names, combo)), {}) for combo in itertools.product(*axes.values())]
+    out = []
+    for row in sample.design_matrix():
+        values, factors = sample.values(row)
+        for target, source in sample.same.items():
+            (factors if source in factors else values)[target] = (
+                factors[source] if source in factors else values[source])
+        out.append((values, factors))
+    return out
+
+
+def own_value(params: Parameters, name: str) -> float:
+    """A model parameter's value at ``params`` in the unit ``name`` carries: its field, or for a
+    cork coefficient left to the law (None), the law's value."""
+    field_name, to_cgs = resolve_name(name)
+    value = getattr(params, field_name)
+    if value is None and field_name in ("cork_n", "cork_k", "cork_c"):
+        value = getattr(params.cork_law, field_name[len("cork_"):])
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise StudyError(f"[ranges] {name}: a factor needs a numeric parameter, got {value!r}")
+    return float(value) / to_cgs
 
 
 def _short(value) -> str:

@@ -12,6 +12,10 @@ static equilibrium (``tip``, cm):
                 frequency f (sine runs), by a least-squares fit of the
                 window to a constant and those four sinusoids
 
+The subharmonic (sine runs): ``strain1_sub_db``, the strain1 line at half the
+drive frequency over the spectrum's floor around it (dB; :func:`line_level`,
+Welch segments of 1 / SUB_RESOLUTION_HZ s, or the window when shorter).
+
 Contact statistics from the event log (exact times, not samples):
 ``share_<code>`` the fraction of the window in each contact code (0, 1, 2,
 3, 4, 13, 14, 23, 24), ``stick_share`` the fraction in a sticking regime,
@@ -61,6 +65,8 @@ QUANTITIES = {
     "switches_per_s": "switches per s", "stick_share": "stick share",
     "share_0": "free-flight share",
 }
+#: Resolution (Hz) of the spectrum the subharmonic's level is read from.
+SUB_RESOLUTION_HZ = 0.5
 #: Default bound on the relative RMS change between the last two windows.
 STEADY_TOL = 0.05
 
@@ -73,6 +79,46 @@ def psd(t: np.ndarray, x: np.ndarray, segment_s: float = 1.0) -> tuple[np.ndarra
     fs = 1.0 / float(np.median(np.diff(t)))
     return welch(np.asarray(x, dtype=float), fs=fs, nperseg=min(len(t), int(round(segment_s * fs))),
                  detrend="constant")
+
+
+#: A spectral line (:func:`line_level`) is present this far (dB) above its floor: the median of
+#: the bins within +-FLOOR_BAND of its frequency (relative), +-FLOOR_GAP bins around it left out.
+LINE_MARGIN_DB = 10.0
+FLOOR_BAND = 0.5
+FLOOR_GAP = 3
+
+
+def sample_rate(t: np.ndarray) -> float:
+    """The sample rate (Hz) of uniform times t (s); ValueError when not uniform or too few."""
+    dt = np.diff(t)
+    if len(t) < 16 or not np.allclose(dt, dt[0], rtol=1e-6):
+        raise ValueError("the signal needs at least 16 uniform samples")
+    return 1.0 / dt[0]
+
+
+def spectrum(t, x, resolution_hz: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """Welch's power spectral density of x about its mean (:func:`psd`): Hz, PSD."""
+    sample_rate(t)
+    return psd(t, x, segment_s=1.0 / resolution_hz)
+
+
+def line_level(t, x, f_hz: float, resolution_hz: float = 0.5) -> dict:
+    """The line at ``f_hz``: its power, its level over the floor (dB), and present or not.
+
+    The level is NaN (and the line not present) when the spectrum has no bins around the
+    line to take a floor from: a record shorter than a few periods of ``f_hz``."""
+    f, p = spectrum(t, x, resolution_hz)
+    df = f[1] - f[0]
+    k = int(round(f_hz / df))
+    near = slice(max(0, k - 1), k + 2)
+    power = float(p[near].max())
+    band = (np.abs(f - f_hz) <= FLOOR_BAND * f_hz) & (np.abs(np.arange(len(f)) - k) > FLOOR_GAP)
+    floor = float(np.median(p[band])) if band.any() else float("nan")
+    # no floor to stand on (a record too short for bins around the line): no level
+    level = (float("nan") if np.isnan(floor) else
+             10.0 * np.log10(power / floor) if floor > 0 else float("inf"))
+    return {"f_hz": f_hz, "power": power, "floor": floor, "level_db": float(level),
+            "present": bool(level >= LINE_MARGIN_DB)}
 
 
 def parabolic_vertex(a, b, c):
@@ -188,6 +234,8 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
                 out[f"{ch}_h{k:g}"] = a
     if drive_hz:
         out["tip_poincare"] = once_per_period(t[win], tip[win], drive_hz).tolist()
+        out["strain1_sub_db"] = line_level(t[win], data["strain1"][win], drive_hz / 2.0,
+                                           max(SUB_RESOLUTION_HZ, 1.0 / window_s))["level_db"]
     rms_prev = float(np.std(tip[prev])) if prev.sum() > 1 else float("nan")
     rms_last = out["tip_rms"]
     change = abs(rms_last - rms_prev) / rms_last if rms_last > 0 else 0.0
