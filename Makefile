@@ -8,7 +8,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 RESULTS := results
 
-.PHONY: help setup test bench study stress clean
+.PHONY: help setup test bench study stress sensitivity clean
 
 help:  ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-8s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -52,6 +52,9 @@ $(RESULTS)/%/report.md: studies/%.toml $(SOURCES) $(STAMP)
 # The paper's section 6 observations measured in the model, each with a verdict.
 $(RESULTS)/paper/report.md: $(STAMP) studies/paper.py $(SOURCES)
 	$(PY) studies/paper.py --out $(RESULTS)/paper
+
+# Which parameter decides each of the paper's observations: not part of `make study`.
+sensitivity: $(RESULTS)/sensitivity/report.md  ## Sobol' indices of the paper's observations (1 664 runs, about an hour)
 
 # The paper's operating range driven hard (MODEL.md §5-§7): not part of `make study`.
 STRESS := stress stress_paper stress_chirp
