@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from . import figures as F
+from .report import accuracy_lines, range_lines
 from . import observations as O
 from ..model.modes import natural_frequencies
 from ..study.provenance import environment
@@ -201,6 +202,47 @@ def make_sensitivity_report(study, results: str | Path = "results") -> Path:
     return index
 
 
+def together_lines(study, rows: pd.DataFrame) -> list[str]:
+    """The inverse question on the design: the points where every observation holds, with
+    the range of each input over them, or, where none does, which pairs never hold together."""
+    holds = pd.DataFrame({n: rows[f"holds_{n}"] == 1.0 for n in HOLDS})
+    finished = int(rows[f"holds_{next(iter(HOLDS))}"].notna().sum())
+    missing = int(rows.status.isna().sum())
+    lines = ["## Where the observations hold together", ""]
+    if missing:
+        lines += [f"{missing} points of the design have no result (not run yet, or run by "
+                  "another version of the computing code: run the sweep again).", ""]
+    lines += [f"Of {finished} finished points: "
+             + "; ".join(f"{n} holds at {int(h.sum())}" for n, h in holds.items()) + ".", "",
+             "Points where both hold (the diagonal: where each holds):", "",
+             "| | " + " | ".join(holds) + " |", "|---|" + "---|" * len(holds.columns)]
+    for a in holds:
+        lines.append(f"| {a} | " + " | ".join(str(int((holds[a] & holds[b]).sum()))
+                                             for b in holds) + " |")
+    every = holds.all(axis=1).to_numpy()
+    lines.append("")
+    if every.any():
+        design = study.sample.design_matrix()[every]
+        lines += [f"All of them hold at {int(every.sum())} points; over those, each input "
+                  "(a choice: the values drawn; a factor: of the point's own value):", "",
+                  "| input | lowest | highest |", "|---|---|---|"]
+        for j, r in enumerate(study.sample.ranges):
+            if r.kind == "choice":
+                drawn = sorted({r.value(u) for u in design[:, j]})
+                lines.append(f"| {r.name} | {', '.join(drawn)} | |")
+            else:
+                lines.append(f"| {r.name} | {design[:, j].min():.4g} | {design[:, j].max():.4g} |")
+    else:
+        never = [f"{a} and {b}" for i, a in enumerate(holds) for b in list(holds)[i + 1:]
+                 if holds[a].any() and holds[b].any() and not (holds[a] & holds[b]).any()]
+        absent = [a for a in holds if not holds[a].any()]
+        lines.append("No point of the design reproduces them all. "
+                     + (f"Never at any point: {', '.join(absent)}. " if absent else "")
+                     + (f"Each present somewhere but never together: {'; '.join(never)}."
+                        if never else ""))
+    return lines + [""]
+
+
 def render(study, table, rows, sobol, made, out) -> str:
     s = study.sample
     ok = table.status == "ok"
@@ -236,12 +278,8 @@ def render(study, table, rows, sobol, made, out) -> str:
         top = [f"{r.input} {r.ST:.2f} ± {r.ST_conf:.2f}" for r in part.head(2).itertuples()]
         lines.append(f"| {what} | {fig} | {part['mean'].iloc[0]:.3g} | {top[0]} | {top[1]} | "
                      f"{int(part.n_used.iloc[0])} |")
-    holds = {n: rows[f"holds_{n}"] for n in HOLDS}
-    every = pd.concat(holds, axis=1).fillna(0.0).all(axis=1)
-    lines += ["", "## Where the observations hold together", "",
-              f"Of {int(ok.sum())} finished points: "
-              + "; ".join(f"{n} holds at {int((h == 1).sum())}" for n, h in holds.items())
-              + f". All of them at once: {int(every.sum())}.", ""]
+    lines += ["", *together_lines(study, rows), *accuracy_lines(study, table),
+              *range_lines(table)]
     lines += ["## Figures", ""]
     for title, paths in made:
         png, pdf = (p.relative_to(out) for p in paths)

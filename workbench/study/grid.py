@@ -27,6 +27,8 @@ def axis_text(axis: str, value) -> str:
     if name.endswith(")"):                      # 'gap (mm)' -> 'gap 1.016 mm'
         base, unit = name[:-1].split(" (")
         return f"{base} {value:g} {unit}"
+    if isinstance(value, (float, np.floating)):     # a drawn value: six digits say it
+        return f"{name} {value:.6g}"
     return f"{name} {value}"
 
 
