@@ -176,9 +176,11 @@ def main() -> None:
     lines += ["", "The measured error is the run's difference from a companion run at a tenth of "
               "the tolerance and half the coarsest step: the larger of the tip's over its range "
               "and a contact share's (workbench.model.accuracy)."]
-    lines += ["", "Not yet here: the chirp at the lab's level, the Fig. 6 amplitudes against "
-              "the experiment's (the paper's figures carry no numbers in the text), and the "
-              "sensitivity of each verdict to the parameters.", "", "## Figures", ""]
+    lines += ["", "Which parameters decide each verdict: the global sensitivity study "
+              "(`make sensitivity`, [its report](../sensitivity/report.md) when it has run). "
+              "Not yet here: the chirp at the lab's level, and the Fig. 6 amplitudes against "
+              "the experiment's (the paper's figures carry no numbers in the text).", "",
+              "## Figures", ""]
     for title, paths in figures:
         png, pdf = (p.relative_to(args.out) for p in paths)
         lines += [f"### {title}", "", f"![{title}]({png}) ([PDF]({pdf}))", ""]
