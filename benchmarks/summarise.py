@@ -180,6 +180,15 @@ def scaling_table(b) -> list[str]:
             speed = _median(one) / _median(bench) if one else float("nan")
             rows.append(f"| the default grid, 1 s per point | {jobs} | {_median(bench):.0f} | "
                         f"{bench['extra_info']['points']} | {speed:.2f} |")
+    alone = b.get("test_sensitivity_scaling[joblib-1]")
+    for runner, workers in (("joblib", 1), ("joblib", 2), ("dask", 2)):
+        bench = b.get(f"test_sensitivity_scaling[{runner}-{workers}]")
+        if bench:
+            speed = _median(alone) / _median(bench) if alone else float("nan")
+            where = "joblib" if runner == "joblib" else "a Dask LocalCluster"
+            rows.append(f"| the sensitivity design at n = 4, 3 s per point, on {where} | "
+                        f"{workers} | {_median(bench):.0f} | {bench['extra_info']['points']} | "
+                        f"{speed:.2f} |")
     study = b.get("test_make_study")
     if study:
         info = study["extra_info"]
@@ -246,7 +255,7 @@ _TABLE_PREFIXES = {"Cost": ("test_rhs",),
                    "Accuracy": tuple(f"test_accuracy_{solver}[{key}-" for key in WINDOW_CASES
                                      for solver in ("kernel", "controlled", "lsoda")),
                    "A": ("test_workbench_run",),
-                   "Sweeps": ("test_sweep_scaling", "test_make_study")}
+                   "Sweeps": ("test_sweep_scaling", "test_sensitivity_scaling", "test_make_study")}
 
 
 def _sources(b, title) -> str:

@@ -5,6 +5,9 @@
   processes, side by side in one run; each point simulates 1 s instead of
   10 s so that the pair takes minutes.  The speed-up
   is the ratio of the two wall times;
+* the sensitivity study's design (studies/sensitivity.toml) cut to n = 4
+  base samples (52 runs of 3 s) on 1 and 2 joblib workers and on a Dask
+  LocalCluster of 2 worker processes, side by side in one run;
 * ``make study`` whole, warm cache, into an empty results folder: every
   study of the Makefile's STUDIES, the modes, the identification tables
   and the estimator, figures and reports included.
@@ -52,6 +55,43 @@ def test_sweep_scaling(benchmark, tmp_path, default_grid, jobs):
                                  "cpu_s": float(table.wall_s.sum()),
                                  "failed": int((table.status != "ok").sum())})
     assert len(table) == len(default_grid.points)
+
+
+#: The sensitivity design's base samples for the scaling runs.
+SENSITIVITY_N = 4
+
+
+@pytest.fixture(scope="module")
+def small_design(tmp_path_factory):
+    from workbench.study.sensitivity import parse
+    import tomllib
+    path = ROOT / "studies" / "sensitivity.toml"
+    data = tomllib.loads(path.read_text())
+    data["sample"]["n"] = SENSITIVITY_N
+    study = S.from_dict(data, source=str(path))
+    assert study.sample == parse(data["sample"], data["ranges"])
+    warm = dataclasses.replace(study, points=study.points[:2], duration_s=0.1, window_s=0.05)
+    _fresh_run(warm, tmp_path_factory.mktemp("warm"), 2)
+    return study
+
+
+def _on_cluster(study, results, workers):
+    import distributed
+    shutil.rmtree(results, ignore_errors=True)
+    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, host="127.0.0.1",
+                                  dashboard_address=None, processes=True) as cluster:
+        return run_study(study, results, scheduler=cluster.scheduler_address, progress=False)
+
+
+@pytest.mark.parametrize("runner, workers", [("joblib", 1), ("joblib", 2), ("dask", 2)])
+def test_sensitivity_scaling(benchmark, tmp_path, small_design, runner, workers):
+    run = _fresh_run if runner == "joblib" else _on_cluster
+    table = benchmark.pedantic(run, args=(small_design, tmp_path / "res", workers), rounds=1,
+                               iterations=1)
+    benchmark.extra_info.update({"points": len(table), "runner": runner, "workers": workers,
+                                 "cpu_s": float(table.wall_s.sum()),
+                                 "failed": int((table.status != "ok").sum())})
+    assert len(table) == small_design.n_points
 
 
 def _make_study(results):
