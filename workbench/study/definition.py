@@ -11,7 +11,8 @@
                                      # controlled method's coarsest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
     check_accuracy = true            # optional: each point also run at a tenth of tol and half
-                                     # the step (a quarter of a fixed dt), its error measured against it (accuracy.py)
+                                     # the step (a quarter of a fixed dt), its error measured
+                                     # against that companion (model/accuracy.py)
     tip_limit_cm = 5.0               # optional: a response-limited drive, each point's force the
                                      # largest up to force_n keeping the tip within it (leveling.py)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
@@ -33,6 +34,10 @@
 Every key is checked before anything runs (:func:`load`), and every grid
 point's model parameters and excitation are built once, so a bad value is
 reported with the parameter's allowed range, not halfway through a sweep.
+
+A ``[sample]`` table with ``[ranges]`` instead of ``[axes]`` draws the points
+from a Saltelli design for a global sensitivity study
+(:mod:`workbench.study.sensitivity` describes both tables).
 
 A stepped sweep (``sweep = "up"`` etc.) runs each frequency from the final
 state of the previous one, all other axes equal; the soft start applies to
@@ -272,10 +277,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     names = list(axes)
     where = {"duration": "[study] duration_s", "dt": "[study] dt", "output_hz": "[study] output_hz"}
     for k in allowed_exc:
-        where[k] = f"[axes] {k}" if k in axes else f"[excitation] {k}"
-    for k in allowed_exc:
-        if k in inputs:
-            where[k] = f"[ranges] {k}"
+        where[k] = f"[{'axes' if k in axes else 'ranges' if k in inputs else 'excitation'}] {k}"
     points = []
     for values, factors in _combinations(axes, sample):
         try:
