@@ -252,8 +252,11 @@ def render(study, table, rows, sobol, made, out) -> str:
              f"{study.duration_s:g} s (the observations over the last {study.window_s:g} s); "
              f"{int(ok.sum())} finished, {int((~ok).sum())} did not. Cost: "
              f"{table.wall_s.sum():.0f} CPU s for {table.get('simulated_s', pd.Series(0.0)).sum():.0f}"
-             " simulated s.", "",
-             "## Inputs", "", "| input | drawn from | kind |", "|---|---|---|"]
+             " simulated s.", ""]
+    if (out / "short_runs.md").is_file():
+        lines += ["Whether these short runs say what 10 s runs say, on points of the design: "
+                  "[short_runs.md](short_runs.md).", ""]
+    lines += ["## Inputs", "", "| input | drawn from | kind |", "|---|---|---|"]
     for r in s.ranges:
         drawn = (", ".join(r.choices) if r.kind == "choice" else f"{r.lo:g} to {r.hi:g}"
                  + (" times its own value" if r.kind == "times" else ""))
