@@ -85,13 +85,16 @@ def test_a_study_with_a_tip_limit_levels_each_point(tmp_path):
     a lower force and stays within 3 cm."""
     path = tmp_path / "lev.toml"
     path.write_text(STUDY.format(limit=3.0, drive="sine",
-                                 extra="force_n = 200.0\nfreq_hz = 20.0\nramp_s = 0.25"))
+                                 extra="force_n = 200.0\nfreq_hz = 20.0\nramp_s = 0.25")
+                    .replace("tip_limit_cm", "check_accuracy = true\ntip_limit_cm"))
     study = S.load(path)
     assert study.tip_limit_cm == 3.0
     W.sweep(study, results=tmp_path / "res", jobs=1, progress=False)
     row = pd.read_parquet(tmp_path / "res" / "lev" / "points.parquet").iloc[0]
     assert row.status == "ok" and row.level_met and row.level_runs >= 2
     assert row.force_n_used < 200.0 and row.tip_abs_max_cm <= 3.0
+    # the accepted run, checked against its companion
+    assert 0.0 < row.error_measured < 1e-3
 
 
 def test_a_tip_limit_needs_a_drive_with_a_force(tmp_path):
