@@ -40,7 +40,6 @@ from ..model.modes import natural_frequencies
 from ..study.provenance import environment
 from ..study.sensitivity import indices
 from ..study.store import read_runs, write_text_atomic
-from ..study.sweep import point_key
 
 #: The chirp of Fig. 11-12: its start and end (Hz) and length (min).
 CHIRP_F0_HZ, CHIRP_F1_HZ, CHIRP_MIN = 5.0, 65.0, 4.0
@@ -91,10 +90,12 @@ def band_times(params) -> tuple[float, float]:
 
 def design_table(study, table: pd.DataFrame) -> pd.DataFrame:
     """The points table in the design's row order, every output and indicator as a column
-    (NaN where a point failed), the band proxies added.  Rows are found by the points' keys:
-    two rows of the design can be one point (a choice drawn the same from both matrices)."""
-    keys = [point_key(study, p) for p in study.points]
-    rows = table.drop_duplicates("key").set_index("key").reindex(keys).reset_index()
+    (NaN where a point failed), the band proxies added.  Two rows of the design can be one
+    point (a choice drawn the same from both matrices): the sweep ran it once, under the
+    first row's index (``chain``), and the later row takes that result."""
+    first: dict = {}
+    source = [first.setdefault(_identity(p), i) for i, p in enumerate(study.points)]
+    rows = table.drop_duplicates("chain").set_index("chain").reindex(source).reset_index(drop=True)
     ok = rows.status == "ok"
     for col, _, _ in OUTPUTS:
         if col not in rows:
@@ -107,6 +108,11 @@ def design_table(study, table: pd.DataFrame) -> pd.DataFrame:
         holds = rule(rows).astype(float)
         rows[f"holds_{name}"] = holds.where(ok)
     return rows
+
+
+def _identity(point) -> str:
+    """What makes two points one run: their parameters and drive."""
+    return json.dumps([point.params.to_dict(), point.excitation], sort_keys=True, default=repr)
 
 
 def sobol_table(study, rows: pd.DataFrame) -> pd.DataFrame:
