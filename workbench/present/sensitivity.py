@@ -91,11 +91,18 @@ def band_times(params) -> tuple[float, float]:
 def design_table(study, table: pd.DataFrame) -> pd.DataFrame:
     """The points table in the design's row order, every output and indicator as a column
     (NaN where a point failed), the band proxies added.  Two rows of the design can be one
-    point (a choice drawn the same from both matrices): the sweep ran it once, under the
-    first row's index (``chain``), and the later row takes that result."""
-    first: dict = {}
-    source = [first.setdefault(_identity(p), i) for i, p in enumerate(study.points)]
-    rows = table.drop_duplicates("chain").set_index("chain").reindex(source).reset_index(drop=True)
+    point (a choice drawn the same from both matrices): the sweep keeps one result for them,
+    under the index (``chain``) of either, and both rows take it."""
+    twins: dict = {}
+    for i, p in enumerate(study.points):
+        twins.setdefault(_identity(p), []).append(i)
+    by_chain = table.drop_duplicates("chain").set_index("chain")
+    source = [None] * study.n_points
+    for group in twins.values():
+        found = next((i for i in group if i in by_chain.index), None)
+        for i in group:
+            source[i] = found
+    rows = by_chain.reindex(source).reset_index(drop=True)
     ok = rows.status == "ok"
     for col, _, _ in OUTPUTS:
         if col not in rows:
