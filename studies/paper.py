@@ -121,18 +121,60 @@ def table(cases: list[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def main() -> None:
+def tag_of(case: dict) -> str:
+    """A case's file name: kind, start, level and any moduli other than the standard."""
+    return f"{case['kind']}_{case['start']}_{case['level']}" + (
+        "" if case["moduli"] == "standard" else f"_{case['moduli']}")
+
+
+def save_cases(cases: list[dict], out: Path) -> None:
+    """Each case's measures to cases.json; its signals and events to cases/<tag>.parquet."""
+    (out / "cases").mkdir(parents=True, exist_ok=True)
+    for c in cases:
+        if "signals" in c:
+            c["signals"].to_parquet(out / "cases" / f"{tag_of(c)}.parquet")
+        if "events" in c:
+            c["events"].astype({"kind": str}).to_parquet(out / "cases" / f"{tag_of(c)}.events.parquet")
+    measures = [{k: v for k, v in c.items() if k not in ("signals", "events")} for c in cases]
+    (out / "cases.json").write_text(json.dumps(measures, indent=1, default=float))
+
+
+def load_cases(out: Path) -> list[dict]:
+    """The cases saved by :func:`save_cases`, their signals and events read back where saved."""
+    cases = json.loads((out / "cases.json").read_text())
+    for c in cases:
+        for key, suffix in (("signals", ".parquet"), ("events", ".events.parquet")):
+            path = out / "cases" / f"{tag_of(c)}{suffix}"
+            if path.is_file():
+                c[key] = pd.read_parquet(path)
+    return cases
+
+
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--jobs", type=int, default=2)
-    args = parser.parse_args()
+    parser.add_argument("--rebuild", action="store_true",
+                        help="write the tables, figures and report from the saved cases, no runs")
+    args = parser.parse_args(argv)
     start_wall = time.perf_counter()
-    jobs = [(kind, s, level) for kind in ("chirp", "sine") for s in STARTS
-            for level in ("default", "lab")]
-    jobs += [("sine", "static", level, "identified") for level in ("default", "lab")]
-    cases = Parallel(n_jobs=args.jobs)(delayed(run_case)(*j) for j in jobs)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "figures").mkdir(exist_ok=True)
+    if args.rebuild:
+        cases = load_cases(args.out)
+    else:
+        jobs = [(kind, s, level) for kind in ("chirp", "sine") for s in STARTS
+                for level in ("default", "lab")]
+        jobs += [("sine", "static", level, "identified") for level in ("default", "lab")]
+        cases = Parallel(n_jobs=args.jobs)(delayed(run_case)(*j) for j in jobs)
+        args.out.mkdir(parents=True, exist_ok=True)
+        save_cases(cases, args.out)
+    write_report(cases, args.out, time.perf_counter() - start_wall)
+    print(f"wrote {args.out}/report.md")
+
+
+def write_report(cases: list[dict], out: Path, wall_s: float) -> None:
+    """The observations' tables, the figures, report.md and provenance.json of the cases."""
+    args = argparse.Namespace(out=out)
+    (args.out / "figures").mkdir(parents=True, exist_ok=True)
     obs = table(cases)
     obs.to_csv(args.out / "observations.csv", index=False)
     (args.out / "observations.md").write_text(obs.to_markdown(index=False) + "\n")
@@ -142,8 +184,7 @@ def main() -> None:
     for c in cases:
         if "signals" not in c:
             continue
-        tag = f"{c['kind']}_{c['start']}_{c['level']}" + (
-            "" if c["moduli"] == "standard" else f"_{c['moduli']}")
+        tag = tag_of(c)
         if c["kind"] == "sine":
             figures.append((f"Strain spectra, {scenario(c)} (Fig. 7-8)",
                             F.save(F.strain_spectra(c["signals"], scenario(c)),
@@ -200,12 +241,13 @@ def main() -> None:
         png, pdf = (p.relative_to(args.out) for p in paths)
         lines += [f"### {title}", "", f"![{title}]({png}) ([PDF]({pdf}))", ""]
     (args.out / "report.md").write_text("\n".join(lines) + "\n")
-    provenance = {**environment(), "study": "paper", "wall_s": time.perf_counter() - start_wall,
+    provenance = {**environment(), "study": "paper", "wall_s": wall_s,
                   "parameters": case_params().to_dict(),
                   "cases": [{k: v for k, v in c.items()
                              if k not in ("signals", "events", "verdicts")} for c in cases]}
     (args.out / "provenance.json").write_text(json.dumps(provenance, indent=1, default=str))
-    print(f"wrote {args.out}/report.md")
+
+
 
 
 if __name__ == "__main__":
