@@ -191,7 +191,7 @@ def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
     if study.tol is None or not len(ok) or "error_over_tol_max" not in ok:
         return ([f"Integration: {study.method}, fixed step "
                  f"{'the stability step' if study.dt is None else f'{study.dt:g} s'}: "
-                 "no error estimate.", ""])
+                 "no error estimate. " + (measured_sentence(ok) if len(ok) else ""), ""])
     worst = ok.loc[ok.error_over_tol_max.idxmax()]
     lines = [f"Integration: {study.method}, tol = {study.tol:g}; the largest error estimate is "
              f"{worst.error_over_tol_max:.3g} of the tolerance ({point_title(worst)}); steps "
@@ -222,8 +222,8 @@ def measured_sentence(ok: pd.DataFrame) -> str:
     checked = ok[ok.error_measured.notna()]
     worst = checked.loc[checked.error_measured.idxmax()]
     above = checked[checked.error_measured > ERROR_BOUND]
-    text = (f"Measured against a companion run (a tenth of the tolerance, half the step), "
-            f"the largest error "
+    text = (f"Measured against a companion run at finer settings (a tenth of the tolerance "
+            f"and half the coarsest step, or a quarter of a fixed step), the largest error "
             f"(the tip's of its range, or a contact share's) is {worst.error_measured:.2g} "
             f"({point_title(worst)}), over {len(checked)} points")
     if len(above):
