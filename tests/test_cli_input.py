@@ -40,6 +40,7 @@ def no_work(monkeypatch, tmp_path):
     monkeypatch.setattr(workbench.model.simulate, "simulate", _stub)
     monkeypatch.setattr(workbench.study.sweep, "run_study", _stub)
     monkeypatch.setattr(workbench.experiments.estimate, "estimate", _stub)
+    monkeypatch.setattr(workbench.experiments.estimate, "fit", _stub)
     monkeypatch.setattr(workbench.present.comparison, "compare", _stub)
     monkeypatch.setenv("WORKBENCH_CRASH_DIR", str(tmp_path / "crash"))
     monkeypatch.chdir(tmp_path)
@@ -130,6 +131,16 @@ CASES = [
     (["estimate", "R", "--fit", "e_b=1", "--max-nfev", "0"], ["--max-nfev", "0"]),
     (["estimate", "R", "--fit", "e_b=1", "--jobs", "0"], ["--jobs", "0"]),
     (["estimate", "R", "--fit", "nothing=1"], ["nothing"]),
+    (["estimate", "--fit", "e_b=6e11"], ["estimate", "FILE", "--paper"]),
+    (["estimate", "R", "--fit", "e_b=6e11", "--paper", "175:11"], ["--paper", "r.lvm"]),
+    (["estimate", "--fit", "e_b=6e11", "--paper", "175"], ["--paper", "SINE_N:CHIRP_N"]),
+    (["estimate", "--fit", "e_b=6e11", "--paper", "0:11"], ["--paper", "(0, "]),
+    (["estimate", "--fit", "e_b=6e11", "--paper", "175:11", "--freq-hz", "20"],
+     ["--paper", "drive options"]),
+    (["estimate", "--fit", "e_b=6e11", "--bounds", "e_a=1:2"], ["--bounds e_a", "--fit"]),
+    (["estimate", "--fit", "e_b=6e11", "--bounds", "e_b=2:1"], ["--bounds e_b=2:1", "LO < HI"]),
+    (["estimate", "--fit", "e_b=6e11", "--bounds", "e_b=1"], ["--bounds e_b=1", "LO:HI"]),
+    (["estimate", "--fit", "e_b=6e11", "--bounds", "e_b=7e11:8e11"], ["start e_b", "(7"]),
     (["compare", "R", "--skip-s", "1e9"], ["--skip-s", "lasts"]),
     (["compare", "R", "--skip-s", "nan"], ["--skip-s", "nan"]),
     (["compare", "R", "--strain-scale", "strain1=abc"], ["--strain-scale strain1=abc"]),
@@ -179,7 +190,9 @@ def test_good_input_reaches_the_work(files, capsys):
                  ["run", "--out", "ok.parquet"],
                  ["sweep", files["S"], "--jobs", "1"],
                  ["compare", files["R"], "--skip-s", "0.05"],
-                 ["estimate", files["R"], "--fit", "e_b=6e11"]):
+                 ["estimate", files["R"], "--fit", "e_b=6e11"],
+                 ["estimate", "--paper", "175:11", "--fit", "e_b=6e11", "--fit", "force_gain=1",
+                  "--bounds", "e_b=4.6e11:7e11"]):
         code, err = outcome(argv, capsys)
         assert code == "accepted", (argv, code, err)
 

@@ -2,14 +2,16 @@
 written, set beside their simulation, turned into FRFs, and fitted."""
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
+from ..model.limits import MAX_FORCE_N
 from ..model.params import ParameterError, Parameters
 from ..study.paths import check_output_dir, check_output_file, staged_output
 from .common import (EXIT_NOT_CONVERGED, EXIT_OK, EXIT_RUN_FAILED, RESULTS, add_format_option,
                      add_jobs_option, add_record_options, check_window, cut,
-                     json_text, number, pair_numbers, read_record,
-                     record_settings, strain_scale, with_option)
+                     json_text, number, pair_numbers, pairs, parameters_of, read_record,
+                     record_settings, shortcut_drive, strain_scale, with_option)
 
 
 def _cmd_convert(args) -> int:
@@ -108,32 +110,78 @@ def _cmd_frf(args) -> int:
 
 
 def _cmd_estimate(args) -> int:
-    from ..experiments.estimate import estimate
+    from ..experiments.estimate import FITTABLE, check_start, estimate, fit
     from ..experiments.matching import setup_from
 
-    from ..experiments.estimate import FITTABLE
     start = pair_numbers(args.fit, "--fit", "START", 0, lo_open=True)
     unknown = sorted(set(start) - set(FITTABLE))
     if unknown:
         raise ParameterError(f"--fit {', '.join(cut(u) for u in unknown)}: not fittable; "
                              f"fittable are {', '.join(FITTABLE)}")
+    bounds = _bounds(args.bounds, start)
+    check_start(start, bounds)
     if args.out:
         check_output_file("--out", args.out, (".csv",))
-    base = with_option(f"--params {args.params}", Parameters.from_toml, args.params) \
-        if args.params else None
-    pairs = []
-    for path in args.files:
-        record = read_record(args, path)
-        check_window(path, record, args.skip_s)
-        pairs.append((record, setup_from(record_settings(args, record.attrs["meta"]), record, base)))
-    fit = estimate(pairs, start, skip_s=args.skip_s, jobs=args.jobs, max_nfev=args.max_nfev)
-    table = fit.table()
+    if args.paper:
+        if args.files:
+            raise ParameterError(f"--paper fits the paper's observations, not files: leave out "
+                                 f"{cut(Path(args.files[0]).name)}")
+        if shortcut_drive(args) or args.force_n is not None or args.skip_s:
+            raise ParameterError("--paper sets its own drives and windows (the 20 Hz sine and the "
+                                 "5-65 Hz chirp): leave out the drive options and --skip-s")
+        from ..experiments.observed import misses, paper_targets
+        targets = paper_targets(parameters_of(args), *args.paper, initial=args.initial)
+        result = fit(targets, start, bounds=bounds, jobs=args.jobs, max_nfev=args.max_nfev,
+                     fd_step=args.fd_step)
+    else:
+        if not args.files:
+            raise ParameterError("estimate needs records to fit (FILE...), or --paper")
+        base = with_option(f"--params {args.params}", Parameters.from_toml, args.params) \
+            if args.params else None
+        recorded = []
+        for path in args.files:
+            record = read_record(args, path)
+            check_window(path, record, args.skip_s)
+            recorded.append((record, setup_from(record_settings(args, record.attrs["meta"]), record,
+                                             base)))
+        result = estimate(recorded, start, skip_s=args.skip_s, bounds=bounds, jobs=args.jobs,
+                          max_nfev=args.max_nfev, fd_step=args.fd_step)
     if args.out:
-        table.to_csv(args.out, index=False)
-    print(json_text({"values": fit.values, "intervals_2sigma": fit.intervals, "cost": fit.cost,
-                      "simulations": fit.n_simulations, "success": fit.success,
-                      "message": fit.message, "wall_s": round(fit.wall_s, 1)}))
-    return EXIT_OK if fit.success else EXIT_NOT_CONVERGED
+        result.table().to_csv(args.out, index=False)
+    out = {"values": result.values, "intervals_2sigma": result.intervals, "cost": result.cost,
+           "simulations": result.n_simulations, "success": result.success,
+           "message": result.message, "wall_s": round(result.wall_s, 1)}
+    if args.paper:
+        out["misses"] = dict(misses(result))
+        out["all_observations_hold"] = not out["misses"]
+    print(json_text(out))
+    return EXIT_OK if result.success else EXIT_NOT_CONVERGED
+
+
+def _bounds(items: list[str], start: dict) -> dict:
+    """--bounds NAME=LO:HI of fitted parameters (CGS; force_n in N)."""
+    out = {}
+    for name, text in pairs(items, "--bounds", "LO:HI").items():
+        if name not in start:
+            raise ParameterError(f"--bounds {cut(name)}: not a parameter given by --fit")
+        try:
+            lo, hi = (float(v) for v in text.split(":"))
+        except ValueError:
+            raise ParameterError(f"--bounds {cut(name)}={cut(text)}: give LO:HI, two numbers") from None
+        if not 0.0 < lo < hi:
+            raise ParameterError(f"--bounds {cut(name)}={cut(text)}: need 0 < LO < HI")
+        out[name] = (lo, hi)
+    return out
+
+
+def _paper_forces(text: str) -> tuple[float, float]:
+    try:
+        sine_n, chirp_n = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give SINE_N:CHIRP_N, two forces in N") from None
+    if not (0.0 < sine_n <= MAX_FORCE_N and 0.0 < chirp_n <= MAX_FORCE_N):
+        raise argparse.ArgumentTypeError(f"{text!r}: each force within (0, {MAX_FORCE_N:g}] N")
+    return sine_n, chirp_n
 
 
 def add_parsers(sub) -> None:
@@ -179,11 +227,25 @@ def add_parsers(sub) -> None:
                       help="scale factor of a strain channel recorded in V (strain per volt)")
     conv.set_defaults(func=_cmd_convert)
 
-    est = sub.add_parser("estimate", help="fit model parameters to measurement files (§7.2)")
-    est.add_argument("files", nargs="+", help="records (.lvm or tab-delimited)")
+    est = sub.add_parser("estimate", help="fit model parameters to measurement files, or to the "
+                         "paper's observations (§7.2)")
+    est.add_argument("files", nargs="*", help="records (.lvm or tab-delimited)")
     est.add_argument("--fit", metavar="NAME=START", action="append", required=True,
                      help="a parameter to fit and its start (CGS; force_n in N), repeatable; "
-                          "fittable: e_a, e_b, zeta_a, zeta_b, mu, cork_k, cork_c, force_n")
+                          "fittable: e_a, e_b, zeta_a, zeta_b, mu, cork_k, cork_c, force_n, "
+                          "force_gain (a factor on every drive's force)")
+    est.add_argument("--bounds", metavar="NAME=LO:HI", action="append", default=[],
+                     help="the range searched for a fitted parameter (default: wide, "
+                          "workbench/experiments/estimate.py FITTABLE)")
+    est.add_argument("--paper", type=_paper_forces, metavar="SINE_N:CHIRP_N",
+                     help="fit to the paper's §6 observations instead of files: switching "
+                          "between 14 and 23 and the 10 Hz subharmonic on the 20 Hz sine at "
+                          "SINE_N, the bands near 0.83, 1.67 and 3 min on the 240 s chirp at "
+                          "CHIRP_N (workbench/experiments/observed.py)")
+    est.add_argument("--initial", choices=("static", "paper"), default="static",
+                     help="with --paper: the runs' start")
+    est.add_argument("--fd-step", type=number(0, 1, lo_open=True), default=0.02,
+                     help="the Jacobian's relative difference step (default 0.02)")
     add_record_options(est)
     add_jobs_option(est, "worker processes")
     est.add_argument("--max-nfev", type=number(1, 100000, integer=True), default=30, help="most residual evaluations")

@@ -23,6 +23,9 @@ A simulation that fails scores :data:`FAILED_RESIDUAL` on every feature.
 
     fit = estimate([(record, setup)], {"e_b": 7e11, "force_n": 20.0})
     fit.values, fit.intervals, fit.cost
+
+:func:`fit` is the same search against any targets that give residuals of a run;
+:mod:`workbench.experiments.observed` makes the paper's §6 observations such targets.
 """
 from __future__ import annotations
 
@@ -40,12 +43,13 @@ from ..study.metrics import CONTACT_CODES, psd
 from ..model.params import ParameterError
 
 #: What can be fitted: name -> (where it lives, lower, upper bound).  "param" is a
-#: field of Parameters (CGS), "mu" sets mu_s = mu_k, "excitation" a drive setting (N).
+#: field of Parameters (CGS), "mu" sets mu_s = mu_k, "excitation" a drive setting (N),
+#: "gain" a factor on every target's own drive force (a shaker's calibration, one for all).
 FITTABLE = {
     "e_a": ("param", 1.0e11, 2.0e12), "e_b": ("param", 1.0e11, 2.0e12),
     "zeta_a": ("param", 1.0e-4, 0.2), "zeta_b": ("param", 1.0e-4, 0.2),
     "mu": ("mu", 0.01, 2.0), "cork_k": ("param", 1.0, 1.0e9), "cork_c": ("param", 1.0, 1.0e7),
-    "force_n": ("excitation", 0.01, 1000.0),
+    "force_n": ("excitation", 0.01, 1000.0), "force_gain": ("gain", 0.01, 100.0),
 }
 #: Edges of the PSD bands (Hz).
 BANDS_HZ = (5.0, 8.0, 12.0, 17.0, 23.0, 30.0, 40.0, 55.0, 75.0, 100.0, 140.0, 200.0)
@@ -82,10 +86,10 @@ def _apply(setup: Setup, values: dict[str, float]) -> Setup:
     params, exc = {}, dict(setup.excitation)
     for name, value in values.items():
         where = FITTABLE[name][0]
-        if where == "excitation":
-            if name not in exc:
+        if where in ("excitation", "gain"):
+            if "force_n" not in exc or (where == "excitation" and name not in exc):
                 raise ParameterError(f"{name} is not a setting of a {exc['drive']} drive")
-            exc[name] = value
+            exc["force_n"] = value if where == "excitation" else value * exc["force_n"]
         elif where == "mu":
             params.update(mu_s=value, mu_k=value)
         else:
@@ -93,16 +97,35 @@ def _apply(setup: Setup, values: dict[str, float]) -> Setup:
     return dataclasses.replace(setup, params=setup.params.replace(**params), excitation=exc)
 
 
-def _simulated_features(setup: Setup, values: dict, channels, skip_s: float, n_features: int):
-    run = _apply(setup, values).simulate()
+@dataclass(frozen=True)
+class RecordTarget:
+    """A measured record as a target: the residuals are the simulated record's features
+    less the measured one's (module docstring)."""
+
+    setup: Setup
+    target: np.ndarray
+    channels: tuple
+    skip_s: float
+
+    @property
+    def labels(self) -> list[str]:
+        return [f"feature {i}" for i in range(len(self.target))]
+
+    def residuals(self, run) -> np.ndarray:
+        return features(record_from_run(run), self.channels, self.skip_s) - self.target
+
+
+def _simulated_residuals(target, values: dict):
+    run = _apply(target.setup, values).simulate()
     if not run.ok:
-        return np.full(n_features, FAILED_RESIDUAL), False
-    return features(record_from_run(run), channels, skip_s), True
+        return np.full(len(target.labels), FAILED_RESIDUAL), False
+    return np.asarray(target.residuals(run), dtype=float), True
 
 
 @dataclass
 class Estimate:
-    """The fitted values, their two-sigma intervals and how the fit went."""
+    """The fitted values, their two-sigma intervals and how the fit went; ``residuals``
+    at the fitted values, one per ``labels``."""
 
     values: dict
     start: dict
@@ -113,6 +136,8 @@ class Estimate:
     message: str
     wall_s: float
     history: list = field(default_factory=list)     # (values, cost) of each residual evaluation
+    residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    labels: list = field(default_factory=list)
 
     def table(self, truth: dict | None = None) -> pd.DataFrame:
         rows = []
@@ -128,25 +153,46 @@ class Estimate:
 
 def estimate(records: list[tuple[pd.DataFrame, Setup]], start: dict[str, float], *,
              channels=None, skip_s: float = 0.0, bounds: dict | None = None, jobs: int = 2,
-             max_nfev: int = 30, xtol: float = 1e-3) -> Estimate:
+             max_nfev: int = 30, xtol: float = 1e-3, fd_step: float = FD_STEP) -> Estimate:
     """Fit the parameters named in ``start`` (initial values, CGS; force_n in N) to
     ``records``, each a (record, Setup) pair; see the module docstring."""
-    from joblib import Parallel, delayed
-    from scipy.optimize import least_squares
+    check_start(start, bounds)
+    channels = tuple(channels or [c for c in SIGNALS if c != "force1"
+                                  and all(c in rec.columns for rec, _ in records)])
+    targets = [RecordTarget(setup, features(rec, channels, skip_s), channels, skip_s)
+               for rec, setup in records]
+    return fit(targets, start, bounds=bounds, jobs=jobs, max_nfev=max_nfev, xtol=xtol,
+               fd_step=fd_step)
 
+
+def check_start(start: dict, bounds: dict | None = None) -> dict:
+    """The bounds of each parameter in ``start``; a ParameterError if one cannot be fitted
+    or starts outside its bounds."""
     unknown = sorted(set(start) - set(FITTABLE))
     if unknown or not start:
         raise ParameterError(f"cannot fit {unknown or 'nothing'}: fittable are {', '.join(FITTABLE)}")
+    lims = {n: (bounds or {}).get(n, FITTABLE[n][1:]) for n in start}
+    for n, (lo, hi) in lims.items():
+        if not lo < start[n] < hi:
+            raise ParameterError(f"start {n} = {start[n]:g} is outside the allowed range "
+                                 f"({lo:g}, {hi:g})")
+    return lims
+
+
+def fit(targets: list, start: dict[str, float], *, bounds: dict | None = None, jobs: int = 2,
+        max_nfev: int = 30, xtol: float = 1e-3, fd_step: float = FD_STEP) -> Estimate:
+    """Fit the parameters named in ``start`` to ``targets``: each has a ``setup`` (a
+    :class:`~workbench.experiments.matching.Setup`), ``labels`` (one per residual) and
+    ``residuals(run)``, zero where the run matches it (:class:`RecordTarget`, or the paper's
+    observations of :mod:`workbench.experiments.observed`).  Nonlinear least squares in the
+    parameters' logs within ``bounds`` (default FITTABLE's), the Jacobian by forward
+    differences of ``fd_step``, every simulation of one Jacobian in parallel on ``jobs``
+    processes."""
+    from joblib import Parallel, delayed
+    from scipy.optimize import least_squares
+
+    lims = check_start(start, bounds)
     names = list(start)
-    lims = {n: (bounds or {}).get(n, FITTABLE[n][1:]) for n in names}
-    for n in names:
-        if not lims[n][0] < start[n] < lims[n][1]:
-            raise ParameterError(f"start {n} = {start[n]} is outside the allowed range "
-                                 f"({lims[n][0]}, {lims[n][1]})")
-    channels = channels or [c for c in SIGNALS if c != "force1"
-                            and all(c in rec.columns for rec, _ in records)]
-    targets = [features(rec, channels, skip_s) for rec, _ in records]
-    sizes = [len(f) for f in targets]
     pool = Parallel(n_jobs=jobs, prefer="processes")
     cache: dict[bytes, np.ndarray] = {}
     history = []
@@ -157,13 +203,12 @@ def estimate(records: list[tuple[pd.DataFrame, Setup]], start: dict[str, float],
 
     def residuals_many(xs):
         todo = [x for x in xs if x.tobytes() not in cache]
-        jobs_ = [(x, i) for x in todo for i in range(len(records))]
-        out = pool(delayed(_simulated_features)(records[i][1], values_of(x), channels, skip_s,
-                                                sizes[i]) for x, i in jobs_)
+        jobs_ = [(x, target) for x in todo for target in targets]
+        out = pool(delayed(_simulated_residuals)(target, values_of(x)) for x, target in jobs_)
         for k, x in enumerate(todo):
-            parts = [out[k * len(records) + i][0] - targets[i] for i in range(len(records))]
-            cache[x.tobytes()] = np.concatenate(parts)
-            history.append((values_of(x), 0.5 * float(cache[x.tobytes()] @ cache[x.tobytes()])))
+            r = np.concatenate([out[k * len(targets) + i][0] for i in range(len(targets))])
+            cache[x.tobytes()] = r
+            history.append((values_of(x), 0.5 * float(r @ r)))
         return [cache[x.tobytes()] for x in xs]
 
     def fun(x):
@@ -171,9 +216,9 @@ def estimate(records: list[tuple[pd.DataFrame, Setup]], start: dict[str, float],
 
     def jac(x):
         x = np.asarray(x, dtype=float)
-        steps = [x + FD_STEP * np.eye(len(x))[j] for j in range(len(x))]
+        steps = [x + fd_step * np.eye(len(x))[j] for j in range(len(x))]
         r0, *rs = residuals_many([x] + steps)
-        return np.column_stack([(r - r0) / FD_STEP for r in rs])
+        return np.column_stack([(r - r0) / fd_step for r in rs])
 
     with pool:
         x0 = np.log([start[n] for n in names])
@@ -188,5 +233,7 @@ def estimate(records: list[tuple[pd.DataFrame, Setup]], start: dict[str, float],
     fitted = values_of(res.x)
     intervals = {n: (fitted[n] * float(np.exp(-h)), fitted[n] * float(np.exp(h)))
                  for n, h in zip(names, half)}
-    return Estimate(fitted, dict(start), intervals, float(res.cost), len(cache) * len(records),
-                    bool(res.success), str(res.message), time.perf_counter() - t_wall, history)
+    labels = [label for target in targets for label in target.labels]
+    return Estimate(fitted, dict(start), intervals, float(res.cost), len(cache) * len(targets),
+                    bool(res.success), str(res.message), time.perf_counter() - t_wall, history,
+                    np.asarray(res.fun, dtype=float), labels)

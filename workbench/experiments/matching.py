@@ -24,12 +24,14 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Setup:
-    """One simulation: parameters, excitation settings (user units), length (s), rate (Hz)."""
+    """One simulation: parameters, excitation settings (user units), length (s), rate (Hz),
+    and its start ("static" or "paper", as :func:`~workbench.model.simulate.simulate`)."""
 
     params: Parameters
     excitation: dict
     duration: float
     output_hz: float
+    initial: str = "static"
 
     def simulate(self, params: Parameters | None = None, excitation: dict | None = None):
         """Run it (optionally with other parameters or excitation settings)."""
@@ -37,7 +39,8 @@ class Setup:
 
         exc = excitation or self.excitation
         return simulate(params or self.params, drives.excitation_array(exc), self.duration,
-                        output_hz=self.output_hz, **drives.start_keywords(exc))
+                        output_hz=self.output_hz, initial=self.initial,
+                        **drives.start_keywords(exc))
 
 
 def settings_of(excitation: dict, params: Parameters) -> dict:
