@@ -75,11 +75,14 @@ class SineObservations:
         return {"share_14": shares.get("14", 0.0), "share_23": shares.get("23", 0.0),
                 "sub_db": sub["level_db"]}
 
-    def residuals(self, run) -> np.ndarray:
-        m = self.measures(run)
+    def miss(self, m: dict) -> np.ndarray:
+        """Each rule's miss (module docstring) given the measures."""
         sub = 1.0 if np.isnan(m["sub_db"]) else (LINE_MARGIN_DB - m["sub_db"]) / LINE_MARGIN_DB
-        return residual([(O.DOMINANT_SHARE - m["share_14"]) / O.DOMINANT_SHARE,
+        return np.array([(O.DOMINANT_SHARE - m["share_14"]) / O.DOMINANT_SHARE,
                          (O.DOMINANT_SHARE - m["share_23"]) / O.DOMINANT_SHARE, sub])
+
+    def residuals(self, run) -> np.ndarray:
+        return residual(self.miss(self.measures(run)))
 
 
 @dataclass(frozen=True)
@@ -98,8 +101,12 @@ class ChirpBands:
         bands = O.resonance_bands(sig.index.to_numpy(), sig.strain1.to_numpy(), self.skip_s)
         return {"bands_min": [b / 60.0 for b in bands]}
 
+    def miss(self, m: dict) -> np.ndarray:
+        """Each paper band's miss given the measures."""
+        return band_misses(m["bands_min"], self.setup.duration / 60.0)
+
     def residuals(self, run) -> np.ndarray:
-        return residual(band_misses(self.measures(run)["bands_min"], self.setup.duration / 60.0))
+        return residual(self.miss(self.measures(run)))
 
 
 def band_misses(bands_min, chirp_min: float) -> np.ndarray:
