@@ -55,8 +55,16 @@ def residual(miss):
     return np.maximum(0.0, np.asarray(miss, dtype=float) + SEARCH_MARGIN)
 
 
+class _Observed:
+    """A case's observations as a target: ``measures(run)`` (a dict), ``miss(measures)`` (one
+    per ``labels``) and the search's ``residuals(run)``."""
+
+    def residuals(self, run) -> np.ndarray:
+        return residual(self.miss(self.measures(run)))
+
+
 @dataclass(frozen=True)
-class SineObservations:
+class SineObservations(_Observed):
     """Fig. 7-10 on a 20 Hz sine run: codes 14 and 23 dominate, the subharmonic is present."""
 
     setup: Setup
@@ -81,12 +89,9 @@ class SineObservations:
         return np.array([(O.DOMINANT_SHARE - m["share_14"]) / O.DOMINANT_SHARE,
                          (O.DOMINANT_SHARE - m["share_23"]) / O.DOMINANT_SHARE, sub])
 
-    def residuals(self, run) -> np.ndarray:
-        return residual(self.miss(self.measures(run)))
-
 
 @dataclass(frozen=True)
-class ChirpBands:
+class ChirpBands(_Observed):
     """Fig. 11-12 on a chirp run: a band within BAND_MATCH_MIN of each of the paper's."""
 
     setup: Setup
@@ -104,9 +109,6 @@ class ChirpBands:
     def miss(self, m: dict) -> np.ndarray:
         """Each paper band's miss given the measures."""
         return band_misses(m["bands_min"], self.setup.duration / 60.0)
-
-    def residuals(self, run) -> np.ndarray:
-        return residual(self.miss(self.measures(run)))
 
 
 def band_misses(bands_min, chirp_min: float) -> np.ndarray:

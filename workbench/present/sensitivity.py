@@ -269,6 +269,9 @@ def render(study, table, rows, sobol, made, out) -> str:
     if (out / "short_runs.md").is_file():
         lines += ["Whether these short runs say what 10 s runs say, on points of the design: "
                   "[short_runs.md](short_runs.md).", ""]
+    if (out.parent / "paper_fit" / "all" / "report.md").is_file():
+        lines += ["The estimator's search for a set showing the observations together, from the "
+                  "design's best points: [paper_fit](../paper_fit/all/report.md).", ""]
     if (out / "chirp_bands.md").is_file():
         lines += ["The chirp's bands read from the locked modes (a proxy) against the bands of "
                   "real 240 s chirps on points of the design: [chirp_bands.md](chirp_bands.md).", ""]
