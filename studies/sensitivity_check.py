@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 from pathlib import Path
 
 import numpy as np
@@ -62,12 +63,17 @@ def main() -> None:
         chirp_bands(study, out, args.chirps, args.jobs)
 
 
-def chirp_run(params) -> dict:
-    """The bands (min) of the paper's chirp at CHIRP_N with ``params``, and the run's status."""
+def chirp_run(params, saved: Path) -> dict:
+    """The bands (min) of the paper's chirp at CHIRP_N with ``params``, and the run's status;
+    kept in ``saved`` (JSON) and read from there when it is already."""
+    if saved.is_file():
+        return json.loads(saved.read_text())
     target = paper_targets(params, CHIRP_N, CHIRP_N)[1]
     run = target.setup.simulate()
     bands = target.measures(run)["bands_min"] if run.ok else []
-    return {"status": run.status, "bands_min": bands, "wall_s": run.wall_s}
+    out = {"status": run.status, "bands_min": bands, "wall_s": run.wall_s}
+    saved.write_text(json.dumps(out))
+    return out
 
 
 def chirp_bands(study, out: Path, n: int, jobs: int) -> None:
@@ -76,12 +82,15 @@ def chirp_bands(study, out: Path, n: int, jobs: int) -> None:
     order = np.argsort(np.nan_to_num(proxies[:, 1], nan=np.inf), kind="stable")
     order = order[np.isfinite(proxies[order, 1])]
     picked = order[np.linspace(0, len(order) - 1, n).round().astype(int)]
-    runs = Parallel(n_jobs=jobs)(delayed(chirp_run)(study.points[int(i)].params) for i in picked)
+    saved = out / "chirp_bands_points"
+    saved.mkdir(exist_ok=True)
+    runs = Parallel(n_jobs=jobs)(delayed(chirp_run)(study.points[int(i)].params,
+                                                    saved / f"{int(i)}.json") for i in picked)
     records = []
     for i, run in zip(picked, runs):
         p = study.points[int(i)].params
         rec = {"point": int(i), "e_a_gpa": p.e_a / 1e10, "e_b_gpa": p.e_b / 1e10,
-               "gap_mm": p.gap_mm, "cork": p.cork, "status": run["status"],
+               "gap_mm": p.gap * 10.0, "cork": p.cork, "status": run["status"],
                "bands_min": " ".join(f"{b:.2f}" for b in run["bands_min"]),
                "wall_s": run["wall_s"]}
         for k in (0, 1):
