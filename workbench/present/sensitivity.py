@@ -21,8 +21,9 @@ it holds), and writes:
 The chirp's bands (Fig. 11-12) take a 240 s run each; the design reads them
 from the joint-locked modes instead: a mode at f Hz is passed by the
 5-65 Hz, 240 s chirp at (f - 5) / 15 minutes (``band<k>_min``, the k-th mode
-above 5 Hz).  That is the band where the joint stays locked, as at small
-amplitude; contact shifts it (docs/usage.md, "Global sensitivity").
+above 5 Hz).  That is the band where the joint stays locked, as at the lab's
+chirp level; studies/sensitivity_check.py sets it beside real chirps
+(``chirp_bands.md``, docs/verification.md).
 """
 from __future__ import annotations
 
