@@ -133,7 +133,10 @@ def search(which: str, params: Parameters, sine_n: float, jobs: int, out: Path, 
              "| parameter | fitted | 2-sigma interval |", "|---|---|---|"]
     for name, v in result.values.items():
         lo, hi = result.intervals[name]
-        lines.append(f"| {name} | {v:.4g} | {lo:.4g} to {hi:.4g} |")
+        wide = lo < bounds[name][0] or hi > bounds[name][1]
+        lines.append(f"| {name} | {v:.4g} | {lo:.4g} to {hi:.4g}"
+                     + (" (wider than the range searched: the cost hardly moves with it) |"
+                        if wide else " |"))
     lines += ["", "| case | at the start | at the set found |", "|---|---|---|"]
     for t, a, b in zip(targets, start_m, found_m):
         lines.append(f"| {t.setup.excitation['drive']} | {words(a)} | {words(b)} |")
