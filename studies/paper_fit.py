@@ -7,7 +7,7 @@ at which the model shows the paper's observations together?
 Two stages.  The global sensitivity study's design (studies/sensitivity.toml, 1 664 points
 over eleven inputs: its 3 s sines and the chirp bands' locked-mode proxy) is ranked by how
 many of the paper's observations hold at a point, then by the estimator's own cost of its
-misses (workbench/experiments/observed.py); the least squares cost alone prefers a point
+misses (workbench/present/observed.py); the least squares cost alone prefers a point
 between two bands to one on either.  The starts alternate between the two orders (the best
 by count, the best by cost, the second by count, ...).  From each of the ``--starts`` the
 estimator (``workbench estimate --paper SINE_N:CHIRP_N``, the same function) searches E_A,
@@ -31,7 +31,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 
 from workbench.experiments.estimate import _apply, fit
-from workbench.experiments.observed import (SEARCH_MARGIN, SineObservations, band_misses, misses,
+from workbench.present.observed import (SEARCH_MARGIN, SineObservations, band_misses, misses,
                                             paper_targets, residual)
 from workbench.identify.paper import APPENDIX_B_MEAN_E_GPA
 from workbench.model.params import Parameters
@@ -183,7 +183,7 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     lines = [f"# The inverse question: the paper's observations together ({args.targets})", "",
              "The estimator (`workbench estimate --paper SINE_N:CHIRP_N`, "
-             "workbench/experiments/observed.py) searches E_A and E_B within "
+             "workbench/present/observed.py) searches E_A and E_B within "
              f"[{E_RANGE[0] / GPA:g}, {E_RANGE[1] / GPA:g}] GPa and a gain on both drives' "
              f"forces (the sine within {FORCE_RANGE_N[0]:g}-{FORCE_RANGE_N[1]:g} N; the chirp "
              f"at {CHIRP_N:g} N times the gain), the ranges of {DESIGN}. Each residual is an "

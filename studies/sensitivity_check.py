@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from workbench.experiments.observed import CHIRP_SKIP_S, paper_targets
+from workbench.present.observed import CHIRP_SKIP_S, paper_targets
 from workbench.present import observations as O
 from workbench.present.sensitivity import band_times
 from workbench.study.definition import load

@@ -129,7 +129,7 @@ def _cmd_estimate(args) -> int:
         if shortcut_drive(args) or args.force_n is not None or args.skip_s:
             raise ParameterError("--paper sets its own drives and windows (the 20 Hz sine and the "
                                  "5-65 Hz chirp): leave out the drive options and --skip-s")
-        from ..experiments.observed import misses, paper_targets
+        from ..present.observed import misses, paper_targets
         targets = paper_targets(parameters_of(args), *args.paper, initial=args.initial)
         result = fit(targets, start, bounds=bounds, jobs=args.jobs, max_nfev=args.max_nfev,
                      fd_step=args.fd_step)
@@ -241,7 +241,7 @@ def add_parsers(sub) -> None:
                      help="fit to the paper's §6 observations instead of files: switching "
                           "between 14 and 23 and the 10 Hz subharmonic on the 20 Hz sine at "
                           "SINE_N, the bands near 0.83, 1.67 and 3 min on the 240 s chirp at "
-                          "CHIRP_N (workbench/experiments/observed.py)")
+                          "CHIRP_N (workbench/present/observed.py)")
     est.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="with --paper: the runs' start")
     est.add_argument("--fd-step", type=number(0, 1, lo_open=True), default=0.02,

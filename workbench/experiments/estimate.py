@@ -25,7 +25,7 @@ A simulation that fails scores :data:`FAILED_RESIDUAL` on every feature.
     fit.values, fit.intervals, fit.cost
 
 :func:`fit` is the same search against any targets that give residuals of a run;
-:mod:`workbench.experiments.observed` makes the paper's §6 observations such targets.
+:mod:`workbench.present.observed` makes the paper's §6 observations such targets.
 """
 from __future__ import annotations
 
@@ -184,7 +184,7 @@ def fit(targets: list, start: dict[str, float], *, bounds: dict | None = None, j
     """Fit the parameters named in ``start`` to ``targets``: each has a ``setup`` (a
     :class:`~workbench.experiments.matching.Setup`), ``labels`` (one per residual) and
     ``residuals(run)``, zero where the run matches it (:class:`RecordTarget`, or the paper's
-    observations of :mod:`workbench.experiments.observed`).  Nonlinear least squares in the
+    observations of :mod:`workbench.present.observed`).  Nonlinear least squares in the
     parameters' logs within ``bounds`` (default FITTABLE's), the Jacobian by forward
     differences of ``fd_step``, every simulation of one Jacobian in parallel on ``jobs``
     processes."""

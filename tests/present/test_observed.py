@@ -10,7 +10,7 @@ import pytest
 from workbench.core import layout as ly
 from workbench.experiments.estimate import fit
 from workbench.experiments.matching import Setup
-from workbench.experiments.observed import (SEARCH_MARGIN, SineObservations, band_misses,
+from workbench.present.observed import (SEARCH_MARGIN, SineObservations, band_misses,
                                             misses, residual)
 from workbench.model.params import Parameters
 from workbench.model.regimes import regime_of, set_of_points

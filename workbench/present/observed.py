@@ -35,10 +35,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .matching import Setup
+from . import observations as O
+from ..experiments.matching import Setup
 from ..model.params import Parameters
 from ..model.regimes import contact_shares_of
-from ..present import observations as O
 from ..study.metrics import LINE_MARGIN_DB, line_level
 
 #: The paper's cases: the 20 Hz sine of Fig. 6-10 (10 s, measured after 2 s) and the
