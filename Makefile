@@ -63,7 +63,7 @@ $(RESULTS)/sensitivity/short_runs.md: $(RESULTS)/sensitivity/report.md studies/s
 	$(PY) -m workbench report studies/sensitivity.toml --results $(RESULTS)
 
 # The inverse question: the estimator on the paper's observations, from the design's best points.
-paper-fit: $(RESULTS)/paper_fit/all/report.md  ## search the ranges for a set showing the paper's observations together (after `make sensitivity`; about 40 minutes)
+paper-fit: $(RESULTS)/paper_fit/all/report.md  ## search the ranges for a set showing the paper's observations together (after `make sensitivity`; about 50 minutes)
 
 $(RESULTS)/paper_fit/all/report.md: $(RESULTS)/sensitivity/short_runs.md studies/paper_fit.py
 	$(PY) studies/paper_fit.py --out $(RESULTS)/paper_fit --design $(RESULTS) --starts 2
