@@ -141,6 +141,7 @@ CASES = [
     (["estimate", "--fit", "e_b=6e11", "--bounds", "e_b=2:1"], ["--bounds e_b=2:1", "LO < HI"]),
     (["estimate", "--fit", "e_b=6e11", "--bounds", "e_b=1"], ["--bounds e_b=1", "LO:HI"]),
     (["estimate", "--fit", "e_b=6e11", "--bounds", "e_b=7e11:8e11"], ["start e_b", "(7"]),
+    (["estimate", "R", "--fit", "e_b=6e11", "--initial", "paper"], ["--initial paper", "--paper"]),
     (["compare", "R", "--skip-s", "1e9"], ["--skip-s", "lasts"]),
     (["compare", "R", "--skip-s", "nan"], ["--skip-s", "nan"]),
     (["compare", "R", "--strain-scale", "strain1=abc"], ["--strain-scale strain1=abc"]),

@@ -136,6 +136,9 @@ def _cmd_estimate(args) -> int:
     else:
         if not args.files:
             raise ParameterError("estimate needs records to fit (FILE...), or --paper")
+        if args.initial != "static":
+            raise ParameterError(f"--initial {args.initial}: only with --paper (a record's "
+                                 "start is its own)")
         base = with_option(f"--params {args.params}", Parameters.from_toml, args.params) \
             if args.params else None
         recorded = []
