@@ -36,11 +36,11 @@ from workbench.study.metrics import accel_peak_g
 from workbench.study.provenance import environment
 
 FORCE_N = 200.0
-SINE_S, CHIRP_S, RAMP_S = 10.0, 240.0, 1.0
+SINE_S, CHIRP_S, RAMP_S = O.SINE_S, O.CHIRP_S, O.RAMP_S
 #: The sine's spectra and shares are taken after the soft start and the first transient.
-SKIP_S = 2.0
+SKIP_S = O.SINE_SKIP_S
 #: The chirp's first seconds are transient ("should be ignored", §6).
-CHIRP_SKIP_S = 20.0
+CHIRP_SKIP_S = O.CHIRP_SKIP_S
 STARTS = ("static", "paper")
 #: The beams' moduli: the paper's "standard values" (the model's defaults), or those it
 #: identified from the beams' free decays (§4.4, Appendix B's means; beam 1 is beam A), which
@@ -62,7 +62,7 @@ def run_case(kind: str, start: str, level: str, moduli: str = "standard") -> dic
 
     def at(force, check_accuracy=False):
         drive = (sine(force, O.DRIVE_HZ, ramp_s=RAMP_S) if kind == "sine"
-                 else chirp(force, 5.0, 65.0, CHIRP_S, ramp_s=RAMP_S))
+                 else chirp(force, O.CHIRP_F0_HZ, O.CHIRP_F1_HZ, CHIRP_S, ramp_s=RAMP_S))
         return simulate(p, drive, SINE_S if kind == "sine" else CHIRP_S, initial=start,
                         check_accuracy=check_accuracy)
     if level == "default":

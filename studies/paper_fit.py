@@ -35,24 +35,32 @@ from workbench.present.observed import (SEARCH_MARGIN, SineObservations, band_mi
                                             paper_targets, residual)
 from workbench.identify.paper import APPENDIX_B_MEAN_E_GPA
 from workbench.model.params import Parameters
+from workbench.present import observations as O
 from workbench.present.sensitivity import design_table
 from workbench.study.definition import load
 from workbench.study.provenance import environment
 
 SINE_N, CHIRP_N = 175.0, 11.0
 DESIGN = "studies/sensitivity.toml"
-FORCE_RANGE_N = (50.0, 200.0)
 GPA = 1e10                          # dyn/cm² per GPa
 START = {"e_a": float(APPENDIX_B_MEAN_E_GPA[1]) * GPA, "e_b": float(APPENDIX_B_MEAN_E_GPA[2]) * GPA,
          "force_gain": 1.0}
-#: The sensitivity study's ranges (studies/sensitivity.toml): E 46-70 GPa, the sine 50-200 N.
-E_RANGE = (46.0 * GPA, 70.0 * GPA)
 FD_STEP, MAX_NFEV = 0.05, 8
 
 
+def design_range(name: str) -> tuple[float, float]:
+    """The interval the design (DESIGN) draws an input from, in its user units."""
+    r = next(r for r in load(DESIGN).sample.ranges if r.name == name)
+    return r.lo, r.hi
+
+
+#: The design's ranges: the moduli (dyn/cm²; 46-70 GPa) and the sine's force (N).
+MODULI = {n: tuple(v * GPA for v in design_range(f"{n}_gpa")) for n in ("e_a", "e_b")}
+FORCE_RANGE_N = design_range("force_n")
+
+
 def bounds_for(sine_n: float) -> dict:
-    return {"e_a": E_RANGE, "e_b": E_RANGE,
-            "force_gain": (FORCE_RANGE_N[0] / sine_n, FORCE_RANGE_N[1] / sine_n)}
+    return {**MODULI, "force_gain": (FORCE_RANGE_N[0] / sine_n, FORCE_RANGE_N[1] / sine_n)}
 
 
 def targets_of(which: str, params: Parameters, sine_n: float) -> list:
@@ -72,7 +80,7 @@ def design_costs(results: Path, which: str) -> pd.DataFrame:
             continue
         m = {"share_14": row.share_14, "share_23": row.share_23, "sub_db": row.strain1_sub_db}
         found = [b for b in (row.band1_min, row.band2_min) if np.isfinite(b)]
-        parts = {"sine": sine.miss(m), "chirp": band_misses(found, 4.0)}
+        parts = {"sine": sine.miss(m), "chirp": band_misses(found, O.CHIRP_S / 60.0)}
         miss = np.concatenate([parts[k] for k in (("sine", "chirp") if which == "all"
                                                   else (which,))])
         r = residual(miss)
@@ -127,11 +135,13 @@ def in_units(values: dict, sine_n: float) -> str:
                      for n, v in values.items())
 
 
-def search(which: str, params: Parameters, sine_n: float, jobs: int, out: Path, tag: str) -> list:
-    """The estimator from ``params`` at ``sine_n``: the lines of its part of the report."""
+def search(which: str, params: Parameters, sine_n: float, jobs: int, out: Path,
+           tag: str) -> tuple[list, dict]:
+    """The estimator from ``params`` at ``sine_n``: the lines of its part of the report and
+    a summary of what it found."""
     targets = targets_of(which, params, sine_n)
     bounds = bounds_for(sine_n)
-    start = {"e_a": inside(params.e_a, *E_RANGE), "e_b": inside(params.e_b, *E_RANGE),
+    start = {"e_a": inside(params.e_a, *MODULI["e_a"]), "e_b": inside(params.e_b, *MODULI["e_b"]),
              "force_gain": 1.0}
     t0 = time.perf_counter()
     result = fit(targets, start, bounds=bounds, jobs=jobs, max_nfev=MAX_NFEV, fd_step=FD_STEP)
@@ -184,7 +194,8 @@ def main() -> None:
     lines = [f"# The inverse question: the paper's observations together ({args.targets})", "",
              "The estimator (`workbench estimate --paper SINE_N:CHIRP_N`, "
              "workbench/present/observed.py) searches E_A and E_B within "
-             f"[{E_RANGE[0] / GPA:g}, {E_RANGE[1] / GPA:g}] GPa and a gain on both drives' "
+             + " and ".join(f"[{lo / GPA:g}, {hi / GPA:g}]" for lo, hi in MODULI.values())
+             + " GPa and a gain on both drives' "
              f"forces (the sine within {FORCE_RANGE_N[0]:g}-{FORCE_RANGE_N[1]:g} N; the chirp "
              f"at {CHIRP_N:g} N times the gain), the ranges of {DESIGN}. Each residual is an "
              "observation's miss by its rule (a share of 0.2, 10 dB, 0.25 min), 0 where it "
@@ -229,7 +240,7 @@ def main() -> None:
         (out / "report.md").write_text("\n".join(lines))
     (out / "provenance.json").write_text(json.dumps(
         {"environment": environment(), "targets": args.targets, "starts": found,
-         "bounds": {"e": list(E_RANGE), "force_n": list(FORCE_RANGE_N)}}, indent=2, default=float))
+         "bounds": {**{n: list(v) for n, v in MODULI.items()}, "force_n": list(FORCE_RANGE_N)}}, indent=2, default=float))
     print(out / "report.md")
 
 

@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from workbench.present.observed import CHIRP_SKIP_S, paper_targets
+from workbench.present.observed import paper_targets
 from workbench.present import observations as O
 from workbench.present.sensitivity import band_times
 from workbench.study.definition import load
@@ -107,7 +107,7 @@ def chirp_bands(study, out: Path, n: int, jobs: int) -> None:
              f"{n} points of the design, spread over the second band's proxy time, run as the "
              f"paper's 5-65 Hz chirp of 240 s at {CHIRP_N:g} N from the static equilibrium (the "
              "lab's level of results/paper); the bands are found by the paper report's rule "
-             f"(after {CHIRP_SKIP_S:g} s). For "
+             f"(after {O.CHIRP_SKIP_S:g} s). For "
              "each proxy band (a joint-locked mode), the nearest band the chirp shows and "
              "the offset (min).", "",
              "| point | E_A (GPa) | E_B (GPa) | gap (mm) | cork | chirp's bands (min) | proxy 1 | "

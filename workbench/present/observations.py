@@ -48,6 +48,11 @@ HIGH_HZ = 200.0
 HIGH_SHARE = 0.01
 PAPER_BANDS_MIN = (0.83, 1.667, 3.0)
 BAND_MATCH_MIN = 0.25
+#: The paper's cases: the 20 Hz sine of Fig. 6-10 (10 s, measured after 2 s) and the 5-65 Hz
+#: chirp of Fig. 11-12 (240 s, its first 20 s transient, §6), both with a 1 s soft start.
+SINE_S, SINE_SKIP_S = 10.0, 2.0
+CHIRP_F0_HZ, CHIRP_F1_HZ, CHIRP_S, CHIRP_SKIP_S = 5.0, 65.0, 240.0, 20.0
+RAMP_S = 1.0
 #: A contact code "dominates" above this share; a code "appears" above the second.
 DOMINANT_SHARE = 0.2
 APPEARS_SHARE = 0.01

@@ -41,11 +41,8 @@ from ..model.params import Parameters
 from ..model.regimes import contact_shares_of
 from ..study.metrics import LINE_MARGIN_DB, line_level
 
-#: The paper's cases: the 20 Hz sine of Fig. 6-10 (10 s, measured after 2 s) and the
-#: 5-65 Hz chirp of Fig. 11-12 (240 s, its first 20 s transient), both with a 1 s soft start.
-SINE_S, SINE_SKIP_S = 10.0, 2.0
-CHIRP_F0_HZ, CHIRP_F1_HZ, CHIRP_S, CHIRP_SKIP_S = 5.0, 65.0, 240.0, 20.0
-RAMP_S, OUTPUT_HZ = 1.0, 1000.0
+#: The records' sample rate (Hz); the cases are those of present/observations.py.
+OUTPUT_HZ = 1000.0
 #: How far inside each rule a residual reaches 0 (a fraction of the rule's scale).
 SEARCH_MARGIN = 0.05
 
@@ -68,7 +65,7 @@ class SineObservations(_Observed):
     """Fig. 7-10 on a 20 Hz sine run: codes 14 and 23 dominate, the subharmonic is present."""
 
     setup: Setup
-    skip_s: float = SINE_SKIP_S
+    skip_s: float = O.SINE_SKIP_S
 
     @property
     def labels(self) -> list[str]:
@@ -95,7 +92,7 @@ class ChirpBands(_Observed):
     """Fig. 11-12 on a chirp run: a band within BAND_MATCH_MIN of each of the paper's."""
 
     setup: Setup
-    skip_s: float = CHIRP_SKIP_S
+    skip_s: float = O.CHIRP_SKIP_S
 
     @property
     def labels(self) -> list[str]:
@@ -123,11 +120,11 @@ def paper_targets(params: Parameters, sine_force_n: float, chirp_force_n: float,
     """The paper's two cases as targets, with ``params``: the sine (switching and the
     subharmonic) at ``sine_force_n`` and the chirp (its bands) at ``chirp_force_n`` (N),
     each from ``initial`` ("static" or "paper")."""
-    sine = {"drive": "sine", "force_n": sine_force_n, "freq_hz": O.DRIVE_HZ, "ramp_s": RAMP_S}
-    chirp = {"drive": "chirp", "force_n": chirp_force_n, "f0_hz": CHIRP_F0_HZ,
-             "f1_hz": CHIRP_F1_HZ, "sweep_s": CHIRP_S, "ramp_s": RAMP_S}
-    return [SineObservations(Setup(params, sine, SINE_S, OUTPUT_HZ, initial)),
-            ChirpBands(Setup(params, chirp, CHIRP_S, OUTPUT_HZ, initial))]
+    sine = {"drive": "sine", "force_n": sine_force_n, "freq_hz": O.DRIVE_HZ, "ramp_s": O.RAMP_S}
+    chirp = {"drive": "chirp", "force_n": chirp_force_n, "f0_hz": O.CHIRP_F0_HZ,
+             "f1_hz": O.CHIRP_F1_HZ, "sweep_s": O.CHIRP_S, "ramp_s": O.RAMP_S}
+    return [SineObservations(Setup(params, sine, O.SINE_S, OUTPUT_HZ, initial)),
+            ChirpBands(Setup(params, chirp, O.CHIRP_S, OUTPUT_HZ, initial))]
 
 
 def misses(result) -> list[tuple[str, float]]:

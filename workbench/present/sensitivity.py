@@ -42,8 +42,6 @@ from ..study.provenance import environment
 from ..study.sensitivity import indices
 from ..study.store import read_runs, write_text_atomic
 
-#: The chirp of Fig. 11-12: its start and end (Hz) and length (min).
-CHIRP_F0_HZ, CHIRP_F1_HZ, CHIRP_MIN = 5.0, 65.0, 4.0
 #: Each output: its column, what it measures, and the paper's figure.
 OUTPUTS = (
     ("share_14", "time share of code 14", "Fig. 9-10"),
@@ -82,8 +80,8 @@ def band_times(params) -> tuple[float, float]:
     """The minutes at which the paper's chirp passes the first two joint-locked modes above
     its start frequency (NaN when fewer lie within the chirp)."""
     f = natural_frequencies(params, "locked")
-    inside = f[(f > CHIRP_F0_HZ) & (f < CHIRP_F1_HZ)]
-    minutes = (inside - CHIRP_F0_HZ) / (CHIRP_F1_HZ - CHIRP_F0_HZ) * CHIRP_MIN
+    inside = f[(f > O.CHIRP_F0_HZ) & (f < O.CHIRP_F1_HZ)]
+    minutes = (inside - O.CHIRP_F0_HZ) / (O.CHIRP_F1_HZ - O.CHIRP_F0_HZ) * O.CHIRP_S / 60.0
     padded = np.full(2, np.nan)
     padded[:min(2, len(minutes))] = minutes[:2]
     return float(padded[0]), float(padded[1])
