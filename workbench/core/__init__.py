@@ -5,6 +5,7 @@ hot loop, or raises; the Python layer around it validates, converts units,
 allocates and builds tables.
 """
 
-from . import _cache
+from . import _cache, _linking
 
 _cache.install()   # before any kernel is defined: see _cache for why
+_linking.install()

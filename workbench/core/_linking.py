@@ -1,0 +1,120 @@
+"""Each kernel's machine code once: callers call it instead of carrying a copy.
+
+numba links a callee's LLVM module into every caller's module (its functions
+``linkonce_odr``) and optimises and emits it there again: the event loop's
+top kernels each carried the machine code of every kernel below them, and
+LLVM spent most of its time on these copies (docs/performance.md "Compile
+time").  For the functions of :mod:`workbench.core`, this module links a
+callee's functions ``available_externally`` instead: LLVM still sees their
+bodies (and inlines the small ones as before), but emits no copy; a call that
+is not inlined goes to the callee's own machine code, which the process has
+loaded already (a callee is finalised before its caller links it).
+
+A cached caller then needs its callees' code in the process before its own
+code is loaded.  Its cache entry lists the kernels it links (module,
+function, signature) and the symbols it needs; loading the entry first loads
+those kernels (from the cache, or compiled), and an entry whose symbols are
+still missing (a callee recompiled under a new name) is treated as absent
+and compiled afresh.
+"""
+from __future__ import annotations
+
+import importlib
+import sys
+
+import llvmlite.binding as ll
+from numba.core import caching, codegen
+from numba.core.registry import CPUDispatcher
+
+#: Marks the mangled names of this package's functions (and their wrappers).
+_MARK = "9workbench4core"
+_TAG = "workbench-linked-once"
+
+#: Names of this package's functions whose machine code is loaded in this process.
+_LOADED: set[str] = set()
+
+_numba_module_for_linking = codegen.CPUCodeLibrary._get_module_for_linking
+_numba_finalize = codegen.CPUCodeLibrary.finalize
+_numba_reduce = caching.CompileResultCacheImpl.reduce
+_numba_rebuild = caching.CompileResultCacheImpl.rebuild
+
+
+def _ours(fn) -> bool:
+    return _MARK in fn.name
+
+
+def _module_for_linking(self):
+    """numba's module for linking, with this package's functions ``available_externally``."""
+    if self._shared_module is not None:
+        return self._shared_module
+    mod = _numba_module_for_linking(self)
+    if any(_ours(fn) and not fn.is_declaration for fn in mod.functions):
+        if mod is self._final_module:
+            mod = mod.clone()
+        for fn in mod.functions:
+            if _ours(fn) and not fn.is_declaration and fn.linkage in (
+                    ll.Linkage.external, ll.Linkage.linkonce_odr):
+                fn.linkage = "available_externally"
+        self._shared_module = mod
+    return mod
+
+
+def _own_symbols(module) -> list[str]:
+    """This package's functions a finalised module defines itself."""
+    return [fn.name for fn in module.functions
+            if _ours(fn) and not fn.is_declaration and fn.linkage == ll.Linkage.external]
+
+
+def _finalize(self):
+    _numba_finalize(self)
+    _LOADED.update(_own_symbols(self._final_module))
+
+
+def _is_ours(cache_impl) -> bool:
+    from ._cache import _KernelCacheLocator
+    return isinstance(cache_impl._locator, _KernelCacheLocator)
+
+
+def _dispatchers():
+    for name, module in list(sys.modules.items()):
+        if name.startswith(__package__ + ".") and module is not None:
+            for attr, obj in vars(module).items():
+                if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == name:
+                    yield name, attr, obj
+
+
+def _reduce(self, cres):
+    payload = _numba_reduce(self, cres)
+    if not _is_ours(self):
+        return payload
+    linked = {id(lib) for lib in cres.library._linking_libraries}
+    deps = []
+    for module, attr, disp in _dispatchers():
+        for sig, other in disp.overloads.items():
+            if id(other.library) in linked:
+                deps.append((module, attr, tuple(sig)))
+    own = set(_own_symbols(cres.library._final_module))
+    needed = sorted({fn.name for fn in cres.library._final_module.functions
+                     if _ours(fn) and fn.name not in own})
+    return (_TAG, tuple(deps), tuple(needed), tuple(sorted(own)), payload)
+
+
+def _rebuild(self, target_context, payload):
+    if not (isinstance(payload, tuple) and payload and payload[0] == _TAG):
+        return _numba_rebuild(self, target_context, payload)
+    _tag, deps, needed, own, inner = payload
+    for module, attr, sig in deps:
+        getattr(importlib.import_module(module), attr).compile(sig)
+    if not _LOADED.issuperset(needed):
+        return None                       # a callee changed its name: compile this one afresh
+    cres = _numba_rebuild(self, target_context, inner)
+    _LOADED.update(own)
+    return cres
+
+
+def install() -> None:
+    """Link this package's kernels once (see the module's docstring)."""
+    codegen.CPUCodeLibrary._get_module_for_linking = _module_for_linking
+    codegen.CPUCodeLibrary.finalize = _finalize
+    caching.CompileResultCacheImpl.reduce = _reduce
+    caching.CompileResultCacheImpl.rebuild = _rebuild
