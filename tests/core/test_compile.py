@@ -9,6 +9,7 @@ import sys
 import textwrap
 
 from workbench.core import _cache
+from workbench.model import compile_plan
 from workbench.model.warmup import GROUPS
 
 #: A standard workload: the entry points `workbench compile` compiles (the
@@ -17,16 +18,21 @@ from workbench.model.warmup import GROUPS
 WORKLOAD = "\n".join(textwrap.dedent(code) for code in GROUPS.values()) + textwrap.dedent("""
     import json
     from workbench.core._cache import kernel_versions
-    print(json.dumps(kernel_versions()))
+    from workbench.core._linking import kernel_graph
+    print(json.dumps({"versions": kernel_versions(), "graph": kernel_graph()}))
 """)
 
 
-def test_a_standard_run_compiles_each_kernel_once():
+def _standard_run():
     out = subprocess.run([sys.executable, "-c", WORKLOAD], check=True, capture_output=True,
                          text=True)
-    versions = json.loads(out.stdout.strip().splitlines()[-1])
-    # loaded from the cache, only the entry points show; compiled, every kernel
-    assert {"controlled.run_controlled", "hybrid.run_hybrid"} <= set(versions)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_standard_run_compiles_each_kernel_once():
+    versions = _standard_run()["versions"]
+    # compiled or loaded from the cache (with the kernels it links), every kernel
+    assert {"controlled.run_controlled", "hybrid.run_hybrid", "dynamics.rhs"} <= set(versions)
     assert {k: n for k, n in versions.items() if n > 1} == {}
 
 
@@ -35,3 +41,13 @@ def test_the_cache_holds_one_version_per_kernel():
     entries = _cache.index_entries()
     assert len(entries) > 30
     assert {k: n for k, n in entries.items() if n > 1} == {}
+
+
+def test_the_compile_plan_lists_the_kernels_of_a_standard_run():
+    """workbench/model/compile_plan.json: rewrite it with
+    ``python -m workbench.model.compile_plan --write`` when this fails."""
+    graph = _standard_run()["graph"]
+    plan = compile_plan.load_plan()
+    assert {name: (entry["signature"], entry["links"]) for name, entry in plan.items()} == \
+        {name: (entry["signature"], entry["links"]) for name, entry in graph.items()}
+    assert all(entry["seconds"] > 0 for entry in plan.values())

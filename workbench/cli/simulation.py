@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 import time
 
@@ -36,16 +37,22 @@ def _cmd_modes(args) -> int:
 
 def _cmd_compile(args) -> int:
     from ..core._cache import CACHE_DIR
+    from ..model.compile_plan import compile_parallel, load_plan
     from ..model.warmup import compile_all
-    print(f"workbench: compiling the numba kernels into {CACHE_DIR} ({args.jobs} processes)",
+    jobs = args.jobs or len(os.sched_getaffinity(0))
+    print(f"workbench: compiling the numba kernels into {CACHE_DIR} ({jobs} processes)",
           file=sys.stderr, flush=True)
     t0 = time.perf_counter()
-    failed = 0
-    for name, seconds, error in compile_all(args.jobs):
+    errors = compile_parallel(None, jobs)
+    print(f"  {len(load_plan())} kernels of the plan: {time.perf_counter() - t0:.0f} s")
+    for error in errors:
+        print(f"  FAILED: {error}")
+    for name, seconds, error in compile_all(jobs):
         print(f"  {name}: {seconds:.0f} s" + (f" FAILED: {error}" if error else ""))
-        failed += bool(error)
+        if error:
+            errors.append(error)
     print(f"  total wall time {time.perf_counter() - t0:.0f} s")
-    return EXIT_INTERNAL if failed else EXIT_OK
+    return EXIT_INTERNAL if errors else EXIT_OK
 
 
 def _run_drive(args) -> dict:
@@ -82,22 +89,24 @@ def _cmd_run(args) -> int:
     from ..experiments import files
     from ..experiments.matching import settings_of
     from ..model import drives
-    from ..model.simulate import check_method, check_settings, simulate
+    from ..model.methods import METHODS
+    from ..model.simulate import check_method, check_settings, prepare_kernels, simulate
     n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse,
                                            args.drive))
     if n_drives > 1:
         raise ParameterError("choose one of --freq-hz, --chirp, --free-decay, --impulse, --drive")
     if args.drive_set and args.drive is None:
         raise ParameterError("--drive-set sets a --drive: give --drive KIND")
-    p = parameters_of(args)
     names = dict(RUN_OPTION_NAMES)
+    method, _tol = check_method(args.method, args.tol, dt_given=args.dt is not None, names=names)
+    prepare_kernels(METHODS[method].kernel)     # checking the model and the step runs kernels
+    p = parameters_of(args)
     drive = _run_drive(args)
     if args.drive is not None:
         names.update({key: f"--drive-set {key}" for key in drive if key != "drive"})
     ex = drives.excitation_array(drive)
     start = drives.start_keywords(drive, names)
     check_settings(p, ex, args.duration, args.dt, args.output_hz, names=names)
-    check_method(args.method, args.tol, dt_given=args.dt is not None, names=names)
     if args.out:
         check_output_file("--out", args.out, files.SUFFIXES)
         meta = settings_of(drive, p)
@@ -179,8 +188,8 @@ def add_parsers(sub) -> None:
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "
                           "in parallel processes (make setup)")
-    comp.add_argument("--jobs", type=number(1, 256, integer=True), default=2,
-                      help="processes compiling at once (default 2)")
+    comp.add_argument("--jobs", type=number(1, 256, integer=True), default=None,
+                      help="processes compiling at once (default: the usable cores)")
     comp.set_defaults(func=_cmd_compile)
 
     params = sub.add_parser("params", help="list every parameter with its unit, range and source")

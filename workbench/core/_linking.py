@@ -83,16 +83,20 @@ def _dispatchers():
                     yield name, attr, obj
 
 
+def linked_kernels(library) -> list[tuple[str, str, tuple]]:
+    """The kernels a compiled or cache-loaded library links: (module, name, signature)."""
+    if hasattr(library, "_workbench_links"):
+        return list(library._workbench_links)
+    linked = {id(lib) for lib in library._linking_libraries}
+    return [(module, attr, tuple(sig)) for module, attr, disp in _dispatchers()
+            for sig, other in disp.overloads.items() if id(other.library) in linked]
+
+
 def _reduce(self, cres):
     payload = _numba_reduce(self, cres)
     if not _is_ours(self):
         return payload
-    linked = {id(lib) for lib in cres.library._linking_libraries}
-    deps = []
-    for module, attr, disp in _dispatchers():
-        for sig, other in disp.overloads.items():
-            if id(other.library) in linked:
-                deps.append((module, attr, tuple(sig)))
+    deps = linked_kernels(cres.library)
     own = set(_own_symbols(cres.library._final_module))
     needed = sorted({fn.name for fn in cres.library._final_module.functions
                      if _ours(fn) and fn.name not in own})
@@ -108,6 +112,7 @@ def _rebuild(self, target_context, payload):
     if not _LOADED.issuperset(needed):
         return None                       # a callee changed its name: compile this one afresh
     cres = _numba_rebuild(self, target_context, inner)
+    cres.library._workbench_links = deps
     _LOADED.update(own)
     return cres
 
@@ -118,3 +123,18 @@ def install() -> None:
     codegen.CPUCodeLibrary.finalize = _finalize
     caching.CompileResultCacheImpl.reduce = _reduce
     caching.CompileResultCacheImpl.rebuild = _rebuild
+
+
+def kernel_graph() -> dict:
+    """Every kernel compiled or loaded in this process: {"module.function":
+    {"signature": [numba type names], "links": ["module.function", ...]}} (one
+    entry per kernel; a second version of a kernel would overwrite the first,
+    and tests/core/test_compile.py fails on it)."""
+    out = {}
+    for module, attr, disp in _dispatchers():
+        for sig, cres in disp.overloads.items():
+            out[f"{module.rsplit('.', 1)[-1]}.{attr}"] = {
+                "signature": [repr(t) for t in sig],
+                "links": sorted({f"{m.rsplit('.', 1)[-1]}.{a}"
+                                 for m, a, _s in linked_kernels(cres.library)})}
+    return out

@@ -433,8 +433,10 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if ex.shape != (cx.N_EXC,):
         raise ParameterError("excitation must come from workbench.model.drives (an array of "
                              f"{cx.N_EXC} values)")
-    dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, strict=False)
     method, tol = check_method(method, tol, dt_given=dt_given)
+    kernel = METHODS[method].kernel
+    prepare_kernels(kernel)                             # before the step's eigenvalues
+    dt, decim, n_steps = check_settings(params, ex, duration, dt, output_hz, t0, strict=False)
     if free_decay_cm is not None and int(ex[cx.X_KIND]) != cx.EXC_NONE:
         raise ParameterError("free_decay_cm releases the structure without excitation; "
                              "leave excitation unset")
@@ -453,7 +455,6 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     work.rg[ly.RG_SIGN] = 1.0
     st = np.zeros(ly.N_ST)
     chunk = max(decim, (round(_CHUNK_S / dt) // decim) * decim)
-    kernel = METHODS[method].kernel
     # the kernels sample every k base steps; the record keeps every m-th, its analog
     # channels low-pass filtered first (antialias)
     k = antialias.internal_decimation(decim, dt, np.abs(_eigenvalues(params)).max() / (2 * np.pi))
@@ -476,7 +477,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
-    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
+    compile_s = _compile_unreported.pop(_kernel_name(kernel), 0.0) + compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
                                         np.empty(1), np.empty((1, ly.N_STATE)),
                                         np.empty((1, ly.N_SIG)), np.empty((1, ly.N_LOG)), st,
                                         *controller))
@@ -614,25 +615,53 @@ def fixed_step_summary(dt: float, steps: int) -> dict:
             "intervals_by_step": {f"{dt:.4g}": steps}, "floor_count": 0, "floor_intervals": []}
 
 
-#: What the first compile of the kernels takes (README "Two commands"), for the message.
-COMPILE_NOTE = "about 2 minutes"
+#: What the first compile of a run's kernels takes on this 2-core machine
+#: (docs/performance.md "Compile time"), for the message.
+COMPILE_NOTE = "about 1 minute on 2 cores"
+
+#: The kernels a run uses besides its method's event loop: the linear model's
+#: eigenvalues (the default step) and the static start.
+_RUN_KERNELS = ("dynamics.eval_inertia", "cork.cork_stiffness", "equilibrium.static_state",
+                "equilibrium.newton_set")
+_prepared: set = set()
+#: Seconds compiled for a run kernel not yet reported in a run's ``compile_s``.
+_compile_unreported: dict = {}
+
+
+def _kernel_name(kernel) -> str:
+    return f"{kernel.py_func.__module__.rsplit('.', 1)[-1]}.{kernel.__name__}"
+
+
+def prepare_kernels(kernel) -> None:
+    """Before a process's first run of ``kernel``: when numba's cache lacks any of
+    the run's kernels, compile them in parallel on the usable cores
+    (:mod:`~workbench.model.compile_plan`), saying so on stderr first.  The
+    first run of ``kernel`` reports the seconds in its ``compile_s``.
+    """
+    if not hasattr(kernel, "signatures") or _kernel_name(kernel) in _prepared:
+        return                                      # NUMBA_DISABLE_JIT, or done
+    from . import compile_plan
+    from ..core._cache import CACHE_DIR
+    _prepared.add(_kernel_name(kernel))
+    roots = (_kernel_name(kernel), *_RUN_KERNELS)
+    jobs = compile_plan.jobs_from_environment()
+    if jobs == 0 or not compile_plan.missing(compile_plan.closure(compile_plan.load_plan(), roots)):
+        return
+    print(f"workbench: compiling the numba kernels ({COMPILE_NOTE}; once, then cached in "
+          f"{CACHE_DIR})", file=sys.stderr, flush=True)
+    t = time.perf_counter()
+    compile_plan.compile_parallel(roots, jobs)
+    _compile_unreported[_kernel_name(kernel)] = time.perf_counter() - t
 
 
 def compile_kernel(kernel, args) -> float:
     """Compile a run kernel for these arguments' types, or load it from numba's cache.
 
-    Returns the seconds spent (0 when already in this process).  When no
-    cached machine code exists (the first run after an install or a change
-    of ``workbench/core``), says so on stderr first, with the usual time.
+    Returns the seconds spent (0 when already in this process).
     """
     import numba
     if not hasattr(kernel, "signatures") or kernel.signatures:   # NUMBA_DISABLE_JIT: plain Python
         return 0.0
-    from ..core._cache import CACHE_DIR
-    module = kernel.py_func.__module__.rsplit(".", 1)[-1]
-    if not any(CACHE_DIR.glob(f"{module}.{kernel.__name__}-*.nbi")):
-        print(f"workbench: compiling the numba kernels ({COMPILE_NOTE}; once, then cached in "
-              f"{CACHE_DIR})", file=sys.stderr, flush=True)
     t = time.perf_counter()
     kernel.compile(tuple(numba.typeof(a) for a in args))
     return time.perf_counter() - t

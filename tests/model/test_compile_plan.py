@@ -1,0 +1,70 @@
+"""The parallel compile (workbench/model/compile_plan.py)."""
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from workbench.model import compile_plan
+from workbench.model.params import ParameterError
+
+TOY = {"a": {"signature": [], "links": ["b", "c"], "seconds": 1.0},
+       "b": {"signature": [], "links": ["d"], "seconds": 2.0},
+       "c": {"signature": [], "links": [], "seconds": 5.0},
+       "d": {"signature": [], "links": [], "seconds": 0.5},
+       "e": {"signature": [], "links": [], "seconds": 9.0}}
+
+
+def test_the_closure_and_the_chains_below_each_kernel():
+    assert set(compile_plan.closure(TOY, ["b", "unknown"])) == {"b", "d"}
+    assert set(compile_plan.closure(TOY, ["a"])) == {"a", "b", "c", "d"}
+    assert compile_plan.chain_seconds(TOY) == {"a": 6.0, "b": 2.5, "c": 5.0, "d": 0.5, "e": 9.0}
+
+
+#: In a fresh process with an empty cache: two workers compile _accumulating and
+#: fill_geometry (which it links); then what the cache holds and a second call.
+CASE = textwrap.dedent("""
+    import json
+    from workbench.model import compile_plan
+    roots = ["hybrid._accumulating"]
+    plan = compile_plan.closure(compile_plan.load_plan(), roots)
+    before = compile_plan.missing(plan)
+    errors = compile_plan.compile_parallel(roots, 2)
+    again = compile_plan.compile_parallel(roots, 2)
+    print(json.dumps({"plan": sorted(plan), "before": sorted(before), "errors": errors,
+                      "after": compile_plan.missing(plan), "again": again}))
+""")
+
+
+def test_two_workers_compile_a_kernel_and_its_callee_into_the_cache(tmp_path):
+    out = subprocess.run([sys.executable, "-c", CASE], check=True, capture_output=True, text=True,
+                         env={**os.environ, "WORKBENCH_CACHE_ROOT": str(tmp_path)})
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    assert result["plan"] == ["contact.fill_geometry", "hybrid._accumulating"]
+    assert result["before"] == result["plan"]
+    assert result["errors"] == [] and result["after"] == []
+    assert result["again"] == []
+    assert [p.name.split("-")[0] for p in sorted(tmp_path.glob("numba-*/*.nbi"))] == \
+        ["contact.fill_geometry", "hybrid._accumulating"]
+
+
+def test_a_kernel_that_fails_to_compile_is_reported_and_the_rest_still_compile(tmp_path):
+    plan = {"contact.fill_geometry": {"signature": ["float64"], "links": [], "seconds": 1.0},
+            "contact.eval_geometry": {"signature": ["float64"], "links": ["contact.fill_geometry"],
+                                      "seconds": 1.0}}
+    errors = compile_plan.work(plan, tmp_path)
+    assert [e.split(":")[0] for e in errors] == ["contact.fill_geometry", "contact.eval_geometry"]
+    assert sorted(p.name for p in tmp_path.glob("*.done")) == \
+        ["contact.eval_geometry.done", "contact.fill_geometry.done"]
+
+
+def test_the_number_of_processes_from_the_environment(monkeypatch):
+    monkeypatch.setenv(compile_plan.JOBS_VARIABLE, "0")
+    assert compile_plan.jobs_from_environment() == 0
+    monkeypatch.delenv(compile_plan.JOBS_VARIABLE)
+    assert compile_plan.jobs_from_environment() == len(os.sched_getaffinity(0))
+    monkeypatch.setenv(compile_plan.JOBS_VARIABLE, "two")
+    with pytest.raises(ParameterError, match="WORKBENCH_COMPILE_JOBS='two': expects a whole number"):
+        compile_plan.jobs_from_environment()
