@@ -629,7 +629,8 @@ _compile_unreported: dict = {}
 
 
 def _kernel_name(kernel) -> str:
-    return f"{kernel.py_func.__module__.rsplit('.', 1)[-1]}.{kernel.__name__}"
+    function = getattr(kernel, "py_func", kernel)      # plain Python under NUMBA_DISABLE_JIT
+    return f"{function.__module__.rsplit('.', 1)[-1]}.{function.__name__}"
 
 
 def prepare_kernels(kernel) -> None:
