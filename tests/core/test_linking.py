@@ -74,3 +74,41 @@ def test_a_caller_links_its_callee_without_a_copy_and_loads_it_first(tmp_path):
     again = _step(tmp_path)
     assert again["gaps"] == expected
     assert again["linkage"] == ["declaration"]
+
+
+#: A user's cached jit function that calls a kernel, in a module of its own.
+USER_MODULE = textwrap.dedent("""
+    import numba
+    from workbench.core.contact import eval_geometry
+
+    @numba.njit(cache=True)
+    def gaps(q, P, cg):
+        eval_geometry(q, P, cg)
+        return cg[0, 0] + cg[1, 0]
+""")
+
+USER_STEP = textwrap.dedent("""
+    import json
+    import numpy as np
+    from workbench.core import layout as ly
+    from workbench.model import packing
+    from workbench.model.params import Parameters
+    import user_kernels
+    q = np.zeros(ly.N_DOF); q[ly.PSI] = 0.003; q[ly.V] = 0.004
+    print(json.dumps(user_kernels.gaps(q, packing.pack(Parameters()), np.zeros((8, ly.N_CG)))))
+""")
+
+
+def test_a_users_cached_function_that_calls_a_kernel_loads_in_a_fresh_process(tmp_path):
+    (tmp_path / "user_kernels.py").write_text(USER_MODULE)
+    env = {**os.environ, "WORKBENCH_CACHE_ROOT": str(tmp_path / "cache"),
+           "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    q = np.zeros(ly.N_DOF)
+    q[ly.PSI], q[ly.V] = 0.003, 0.004
+    cg = np.zeros((8, ly.N_CG))
+    eval_geometry(q, packing.pack(Parameters()), cg)
+    runs = [subprocess.run([sys.executable, "-c", USER_STEP], capture_output=True, text=True,
+                           env=env, cwd=tmp_path) for _ in range(2)]
+    assert [r.returncode for r in runs] == [0, 0], runs[-1].stderr[-2000:]
+    assert list((tmp_path / "__pycache__").glob("user_kernels.gaps-*.nbi"))      # cached, then loaded
+    assert [json.loads(r.stdout) for r in runs] == [cg[0, ly.CG_VAL] + cg[1, ly.CG_VAL]] * 2

@@ -15,7 +15,8 @@ code is loaded.  Its cache entry lists the kernels it links (module,
 function, signature) and the symbols it needs; loading the entry first loads
 those kernels (from the cache, or compiled), and an entry whose symbols are
 still missing (a callee recompiled under a new name) is treated as absent
-and compiled afresh.
+and compiled afresh.  So does the cache entry of any jit function that calls
+the kernels (a user's ``njit(cache=True)`` function, say).
 """
 from __future__ import annotations
 
@@ -94,9 +95,9 @@ def linked_kernels(library) -> list[tuple[str, str, tuple]]:
 
 def _reduce(self, cres):
     payload = _numba_reduce(self, cres)
-    if not _is_ours(self):
-        return payload
     deps = linked_kernels(cres.library)
+    if not deps and not _is_ours(self):
+        return payload                    # a function that calls none of the kernels
     own = set(_own_symbols(cres.library._final_module))
     needed = sorted({fn.name for fn in cres.library._final_module.functions
                      if _ours(fn) and fn.name not in own})
