@@ -23,7 +23,7 @@ SOURCES = sorted(CORE.glob("*.py"))
 #: What a kernel module may import (the cache and linking modules reach into
 #: numba's caching and code generation, and numba's LLVM binding, llvmlite).
 ALLOWED_IMPORTS = {"numba", "numpy", "math", "__future__", "hashlib", "os", "shutil", "pathlib",
-                   "time", "pickle", "importlib", "sys", "llvmlite"}
+                   "time", "pickle", "importlib", "sys", "llvmlite", "copy"}
 #: Calls that allocate an array: only kernels compiled with JIT_ALLOC (reference
 #: counts on) may make them; the others have none (config.JIT).
 ALLOCATING = {"np.zeros", "np.empty", "np.ones", "np.full", "np.array", "np.copy",
