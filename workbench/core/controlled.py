@@ -84,7 +84,7 @@ def _took_stepped(st, snap):
     return st[ly.ST_N_STEPPED] != snap[ly.SNAP_START + ly.SNAP_ST, ly.ST_N_STEPPED]
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def _path(t0, m0, n, dt, lev, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
           ev, log, n_log, st, sample, step0, decim, stored, out_t, out_y, out_sig):
     """n lattice steps h = dt / 2^lev (s), the j-th ending at t0 + (m0 + j) h.
@@ -273,7 +273,8 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
         n = seg << k
         status, end_c, left_c = _path(t0, i * n, n, dt, k, stepped_left, P, tab, kc, free, ex,
                                       rec, mat, vec, stages, cg, cw, rg, ev, log, n_log, st,
-                                      False, step0, decim, stored, out_t, out_y, out_sig)
+                                      np.bool_(False), step0, decim, stored, out_t, out_y,
+                                      out_sig)
         ctl[ly.CTL_WORK] += n
         if status == ly.LOG_FULL:
             _restore(ly.SNAP_START, stages, rg, ev, st, snap)
@@ -287,7 +288,8 @@ def run_controlled(y0, t0, dt, n_steps, step0, decim, seg, tol, level_max, P, ta
             h = dt / (1 << (k + 1))
             status, end_f, left_f = _path(t0, i * n, n, dt, k + 1, stepped_left, P, tab, kc, free,
                                           ex, rec, mat, vec, stages, cg, cw, rg, ev, log, end_c,
-                                          st, True, step0, decim, stored, out_t, out_y, out_sig)
+                                          st, np.bool_(True), step0, decim, stored, out_t, out_y,
+                                          out_sig)
             ctl[ly.CTL_WORK] += n
             if status == ly.LOG_FULL:
                 _restore(ly.SNAP_START, stages, rg, ev, st, snap)

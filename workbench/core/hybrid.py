@@ -492,7 +492,7 @@ def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, 
     return status
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
            out_t, out_y, out_sig):
     y = stages[ly.STAGE_CUR]
@@ -507,7 +507,7 @@ def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, s
     return ly.OK
 
 
-@nb.njit(**JIT_INLINE)
+@nb.njit(**JIT)
 def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, out_t, out_y,
           out_sig, log, st):
     """Start (or continue) a run at t from STAGE_CUR: the regime chosen, its events.
