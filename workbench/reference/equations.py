@@ -50,6 +50,8 @@ class Jet:
         return x if isinstance(x, Jet) else Jet.const(x)
 
     def __add__(self, o):
+        if not isinstance(o, Jet) and np.ndim(o) == 0:     # a constant moves the value only
+            return Jet(self.v + o, self.g, self.d1, self.d2)
         o = Jet.lift(o)
         return Jet(self.v + o.v, self.g + o.g, self.d1 + o.d1, self.d2 + o.d2)
 
@@ -59,13 +61,15 @@ class Jet:
         return Jet(-self.v, -self.g, -self.d1, -self.d2)
 
     def __sub__(self, o):
-        return self + (-Jet.lift(o))
+        return self + (-o)
 
     def __rsub__(self, o):
         return Jet.lift(o) - self
 
     def __mul__(self, o):
-        o = Jet.lift(o)
+        if not isinstance(o, Jet):          # constants (one, or one per batch entry) scale
+            c = np.asarray(o, dtype=float)
+            return Jet(self.v * c, self.g * c[..., None], self.d1 * c, self.d2 * c)
         return Jet(self.v * o.v, self.g * o.v[..., None] + self.v[..., None] * o.g,
                    self.d1 * o.v + self.v * o.d1,
                    self.d2 * o.v + 2.0 * self.d1 * o.d1 + self.v * o.d2)
