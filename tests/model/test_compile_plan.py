@@ -17,10 +17,13 @@ TOY = {"a": {"signature": [], "links": ["b", "c"], "seconds": 1.0},
        "e": {"signature": [], "links": [], "seconds": 9.0}}
 
 
-def test_the_closure_and_the_chains_below_each_kernel():
+def test_the_closure_and_the_chains_of_callers_above_each_kernel():
     assert set(compile_plan.closure(TOY, ["b", "unknown"])) == {"b", "d"}
     assert set(compile_plan.closure(TOY, ["a"])) == {"a", "b", "c", "d"}
-    assert compile_plan.chain_seconds(TOY) == {"a": 6.0, "b": 2.5, "c": 5.0, "d": 0.5, "e": 9.0}
+    # d -> b -> a: 0.5 + 2 + 1; c -> a: 5 + 1; e alone
+    assert compile_plan.chain_seconds(TOY) == {"a": 1.0, "b": 3.0, "c": 6.0, "d": 3.5, "e": 9.0}
+    # within a closure, only the callers in it count
+    assert compile_plan.chain_seconds(compile_plan.closure(TOY, ["b"])) == {"b": 2.0, "d": 2.5}
 
 
 #: In a fresh process with an empty cache: two workers compile _accumulating and

@@ -5,8 +5,8 @@ standard workload (:data:`workbench.model.warmup.GROUPS`): each with its one
 signature, the kernels it links (which must be compiled before it) and its
 own compile time on one core (s).  :func:`compile_parallel` runs ``jobs``
 workers, this process and ``jobs - 1`` helper processes: each takes the next
-kernel whose callees are done, the longest chain of compile time below it
-first, claims it with a file, compiles it into numba's cache and marks it
+kernel whose callees are done, the longest chain of compile time above it
+(itself and its callers up to the last) first, claims it with a file, compiles it into numba's cache and marks it
 done; a callee another worker compiled it loads from the cache.  A kernel
 the plan does not know, or a helper that fails, only costs time: whatever is
 left compiles on first use as always.
@@ -70,13 +70,23 @@ def closure(plan: dict, roots) -> dict:
 
 
 def chain_seconds(plan: dict) -> dict:
-    """Per kernel, its compile time plus the longest chain of callees' (s)."""
+    """Per kernel, its compile time plus the longest chain of its callers' in ``plan`` (s).
+
+    A caller compiles after its callees, so a kernel's chain is the least time
+    from its start to the end of the plan; workers take the ready kernel with
+    the longest chain first (list scheduling by highest level first).
+    """
+    callers = {name: [] for name in plan}
+    for name, entry in plan.items():
+        for callee in entry["links"]:
+            if callee in callers:
+                callers[callee].append(name)
     memo = {}
 
     def chain(name):
         if name not in memo:
-            memo[name] = plan[name]["seconds"] + max(
-                (chain(d) for d in plan[name]["links"] if d in plan), default=0.0)
+            memo[name] = plan[name]["seconds"] + max((chain(c) for c in callers[name]),
+                                                     default=0.0)
         return memo[name]
     return {name: chain(name) for name in plan}
 

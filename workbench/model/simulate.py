@@ -619,9 +619,11 @@ def fixed_step_summary(dt: float, steps: int) -> dict:
 #: (docs/performance.md "Compile time"), for the message.
 COMPILE_NOTE = "about 1 minute on 2 cores"
 
-#: The kernels a run uses besides its method's event loop: the linear model's
-#: eigenvalues (the default step) and the static start.
-_RUN_KERNELS = ("dynamics.eval_inertia", "cork.cork_stiffness", "equilibrium.static_state",
+#: The kernels a run uses besides its method's event loop: the model's shape
+#: table and stiffness (packing), the linear model's eigenvalues (the default
+#: step) and the static start.
+_RUN_KERNELS = ("shapes.fill_shape_row", "dynamics.fill_stiffness_damping",
+                "dynamics.eval_inertia", "cork.cork_stiffness", "equilibrium.static_state",
                 "equilibrium.newton_set")
 _prepared: set = set()
 #: Seconds compiled for a run kernel not yet reported in a run's ``compile_s``.
