@@ -136,11 +136,12 @@ def damping_ratios(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np
     return f, zeta
 
 
-@functools.lru_cache(maxsize=256)
+@functools.lru_cache(maxsize=4096)
 def linear_eigenvalues(p: Parameters) -> np.ndarray:
     """Eigenvalues (1/s) of the damped linear system, joint free and locked (concatenated).
 
-    Computed once per parameter set (the array is read-only).
+    Computed once per parameter set (the array is read-only; a study checks its
+    points, then plans them: the cache holds the largest designs' sets).
 
     They set the explicit integrator's step (:func:`workbench.model.simulate.default_dt`):
     the fastest are the beams' axial modes, damped at their own zeta

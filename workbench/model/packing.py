@@ -16,6 +16,7 @@ joint coordinates, so ``fixed=JOINT`` is the locked joint of docs/model.md.
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections import namedtuple
 from collections.abc import Iterable
@@ -93,9 +94,18 @@ def pack(p: Parameters) -> np.ndarray:
     return P
 
 
+@functools.lru_cache(maxsize=None)
+def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The n Gauss-Legendre nodes and weights on [-1, 1] (read-only arrays, computed once)."""
+    nodes, weights = np.polynomial.legendre.leggauss(n)
+    nodes.flags.writeable = False
+    weights.flags.writeable = False
+    return nodes, weights
+
+
 def gauss_table(length: float, n: int) -> np.ndarray:
     """Shape-table rows (n, N_TAB) at the n Gauss-Legendre points of [0, length]."""
-    nodes, weights = np.polynomial.legendre.leggauss(n)
+    nodes, weights = gauss_legendre(n)
     tab = np.zeros((n, ly.N_TAB))
     for i, (x, w) in enumerate(zip(nodes, weights)):
         fill_shape_row(0.5 * (x + 1.0), length, 0.5 * length * w, tab[i])
