@@ -42,13 +42,28 @@ SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
                    ("accel3", "accel3 (cm/s²)"), ("tip", "tip displacement (cm)"))
 
 
+#: Resolution of the PNG files (dots per inch).
+DPI = 120
+
+
 def save(fig, path: Path) -> list[Path]:
     """Write ``fig`` as ``path``.png and ``path``.pdf; return both paths.  The suffixes are
-    appended: a name may hold dots ("spectrogram_gap-1.016mm")."""
+    appended: a name may hold dots ("spectrogram_gap-1.016mm").
+
+    Both files are cropped to the figure's drawn extent plus savefig.pad_inches
+    (matplotlib's ``bbox_inches="tight"``).  The layout and the extent are
+    computed once, at the PNG's resolution, and kept for both files: saving
+    each with "tight" lays the figure out and measures it again per file.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     out = [path.with_name(path.name + ".png"), path.with_name(path.name + ".pdf")]
+    fig.set_dpi(DPI)
+    fig.draw_without_rendering()                  # runs the layout engine, if any
+    fig.set_layout_engine("none")                 # ... and keeps its result
+    extent = fig.get_tightbbox(fig.canvas.get_renderer()).padded(
+        matplotlib.rcParams["savefig.pad_inches"])
     for p in out:
-        fig.savefig(p, dpi=120, bbox_inches="tight")
+        fig.savefig(p, dpi=DPI, bbox_inches=extent)
     plt.close(fig)
     return out
 
