@@ -25,9 +25,10 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)  ## create .venv, install the package (editable) with dev extras, compile the kernels
 
-# Test modules run in parallel processes, one module's tests in one process (its fixtures once).
+# Test modules run in parallel processes, one module's tests in one process (its fixtures once),
+# the longest modules first (tests/conftest.py).
 test: $(STAMP)  ## run the test suite (physics checks included)
-	$(PY) -m pytest -q -n auto --dist loadscope
+	$(PY) -m pytest -q -n auto --dist loadscope --no-loadscope-reorder
 
 # About 65 minutes: a cold compile (1.5), `make study` whole (44), LSODA on windows, the default grid twice (1 s per point).
 bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md and README.md

@@ -28,6 +28,25 @@ def random_state(rng):
     return np.concatenate([rng.normal(size=9) * Q_SCALE, rng.normal(size=9) * QD_SCALE])
 
 
+#: The test modules that take 25 s or more (``pytest --durations=0``), longest first.
+#: ``make test`` hands each worker process one module at a time in collection order
+#: (``--dist loadscope --no-loadscope-reorder``); these go first, so that no long module
+#: starts when the other worker is nearly done.
+LONG_MODULES = ("test_docs.py", "reference/test_reference_events.py", "study/test_sweep.py",
+                "study/test_sensitivity.py", "experiments/test_compare_estimate.py",
+                "experiments/test_frf.py")
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The modules of LONG_MODULES first, in its order; the others as collected."""
+    here = Path(__file__).parent
+
+    def rank(item):
+        module = Path(str(item.fspath)).relative_to(here).as_posix()
+        return LONG_MODULES.index(module) if module in LONG_MODULES else len(LONG_MODULES)
+    items.sort(key=rank)
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(20261122)
