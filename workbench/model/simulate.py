@@ -617,7 +617,7 @@ def fixed_step_summary(dt: float, steps: int) -> dict:
 
 #: What the first compile of a run's kernels takes on this 2-core machine
 #: (docs/performance.md "Compile time"), for the message.
-COMPILE_NOTE = "about 1 minute on 2 cores"
+COMPILE_NOTE = "about 40 s on 2 cores"
 
 #: The kernels a run uses besides its method's event loop: the model's shape
 #: table and stiffness (packing), the linear model's eigenvalues (the default
