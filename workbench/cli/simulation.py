@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
 import time
 
@@ -37,9 +36,9 @@ def _cmd_modes(args) -> int:
 
 def _cmd_compile(args) -> int:
     from ..core._cache import CACHE_DIR
-    from ..model.compile_plan import compile_parallel, load_plan
+    from ..model.compile_plan import compile_parallel, load_plan, usable_cores
     from ..model.warmup import compile_all
-    jobs = args.jobs or len(os.sched_getaffinity(0))
+    jobs = args.jobs or usable_cores()
     print(f"workbench: compiling the numba kernels into {CACHE_DIR} ({jobs} processes)",
           file=sys.stderr, flush=True)
     t0 = time.perf_counter()

@@ -38,11 +38,16 @@ JOBS_VARIABLE = "WORKBENCH_COMPILE_JOBS"
 POLL_S = 0.02
 
 
+def usable_cores() -> int:
+    """The cores this process may run on (the default number of workers)."""
+    return len(os.sched_getaffinity(0))
+
+
 def jobs_from_environment() -> int:
     """Processes for a first-use compile: WORKBENCH_COMPILE_JOBS, or the usable cores."""
     text = os.environ.get(JOBS_VARIABLE, "").strip()
     if not text:
-        return len(os.sched_getaffinity(0))
+        return usable_cores()
     try:
         jobs = int(text)
         if jobs < 0:
@@ -153,7 +158,7 @@ def compile_parallel(roots=None, jobs: int | None = None) -> list[str]:
     plan = load_plan()
     if roots is not None:
         plan = closure(plan, roots)
-    jobs = max(1, jobs or len(os.sched_getaffinity(0)))
+    jobs = max(1, jobs or usable_cores())
     claims = Path(tempfile.mkdtemp(prefix="workbench-compile-"))
     code = ("import json, sys; from pathlib import Path; "
             "from workbench.model.compile_plan import work; "

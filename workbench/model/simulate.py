@@ -477,10 +477,11 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
-    compile_s = _compile_unreported.pop(_kernel_name(kernel), 0.0) + compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
+    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
                                         np.empty(1), np.empty((1, ly.N_STATE)),
                                         np.empty((1, ly.N_SIG)), np.empty((1, ly.N_LOG)), st,
                                         *controller))
+    compile_s += _compile_unreported.pop(_kernel_name(kernel), 0.0)    # prepare_kernels
     t_wall = time.perf_counter()
     parts_analog = []
     n_internal = 0          # internal samples so far: output sample j is internal sample j m
