@@ -616,9 +616,9 @@ def fixed_step_summary(dt: float, steps: int) -> dict:
             "intervals_by_step": {f"{dt:.4g}": steps}, "floor_count": 0, "floor_intervals": []}
 
 
-#: What the first compile of a run's kernels takes on this 2-core machine
-#: (docs/performance.md "Compile time"), for the message.
-COMPILE_NOTE = "about 40 s on 2 cores"
+#: What the first compile of a run's kernels takes on this 2-core machine, from
+#: an idle hour to a busy one (docs/performance.md "Compile time"), for the message.
+COMPILE_NOTE = "15-45 s on 2 cores"
 
 #: The kernels a run uses besides its method's event loop: the model's shape
 #: table and stiffness (packing), the linear model's eigenvalues (the default
