@@ -125,10 +125,18 @@ class HybridReference:
         self.free = self.model.free
         self.rtol, self.atol, self.method = rtol, atol, method
         self._cache = (None, None)
+        self._contact_cache = (None, None)
 
     # ---- geometry (docs/model.md §7, the formulas as written) -------------------------
     def contact(self, q, qd):
-        """Jets of g1..g4 and tau1..tau4."""
+        """Jets of g1..g4 and tau1..tau4; the last state's kept (a regime's
+        event functions ask for the same state's gaps up to four times)."""
+        key = (q.tobytes(), qd.tobytes())
+        if self._contact_cache[0] != key:
+            self._contact_cache = (key, self._contact(q, qd))
+        return self._contact_cache[1]
+
+    def _contact(self, q, qd):
         p = self.p
         s, v, psi = (Jet.coord(q, qd, k) for k in (3, 4, 5))
         c, sn = jcos(psi), jsin(psi)
