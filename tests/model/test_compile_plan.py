@@ -71,3 +71,35 @@ def test_the_number_of_processes_from_the_environment(monkeypatch):
     monkeypatch.setenv(compile_plan.JOBS_VARIABLE, "two")
     with pytest.raises(ParameterError, match="WORKBENCH_COMPILE_JOBS='two': expects a whole number"):
         compile_plan.jobs_from_environment()
+
+
+def test_the_first_use_clock_counts_a_callers_compile_once():
+    """WORKBENCH_COMPILE_JOBS=0: a run's compile_s adds the kernels compiled on first
+    use before its event loop (simulate.FirstUseClock); a callee compiled inside its
+    caller's compile is not counted again."""
+    import time
+
+    import numba
+
+    from workbench.model.simulate import FirstUseClock
+
+    @numba.njit
+    def callee(x):
+        return x + 1.0
+
+    @numba.njit
+    def caller(x):
+        return callee(x) * 2.0
+
+    clock = FirstUseClock().register()
+    try:
+        start = time.perf_counter()
+        assert caller(1.0) == 4.0                   # compiles both, the callee inside
+        wall = time.perf_counter() - start
+        counted = clock.take()
+        assert 0.0 < counted <= wall
+        assert clock.take() == 0.0                  # taken
+        caller(2.0)                                 # compiled already: nothing counted
+        assert clock.take() == 0.0
+    finally:
+        clock.unregister()

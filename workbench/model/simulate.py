@@ -477,11 +477,14 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
+    first_use = _first_use[0].take() if _first_use else 0.0     # the kernels before the loop's
     compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
                                         np.empty(1), np.empty((1, ly.N_STATE)),
                                         np.empty((1, ly.N_SIG)), np.empty((1, ly.N_LOG)), st,
                                         *controller))
-    compile_s += _compile_unreported.pop(_kernel_name(kernel), 0.0)    # prepare_kernels
+    if _first_use:
+        _first_use[0].take()                                # in compile_kernel's seconds
+    compile_s += first_use + _compile_unreported.pop(_kernel_name(kernel), 0.0)
     t_wall = time.perf_counter()
     parts_analog = []
     n_internal = 0          # internal samples so far: output sample j is internal sample j m
@@ -631,6 +634,52 @@ _prepared: set = set()
 _compile_unreported: dict = {}
 
 
+class FirstUseClock:
+    """Seconds numba spends compiling kernels on their first use in this process,
+    counted from numba's ``numba:compile`` events (a caller's compile includes
+    its callees': nested compiles count once), until :meth:`take` reads them.
+
+    With ``WORKBENCH_COMPILE_JOBS=0`` a run's kernels compile on first use,
+    the static start's and the step's eigenvalues' before the event loop's,
+    so a run's ``compile_s`` adds what this clock counted before it.
+    """
+
+    def __init__(self):
+        self.depth, self.started, self.seconds = 0, 0.0, 0.0
+
+    def on_start(self, event):
+        if self.depth == 0:
+            self.started = time.perf_counter()
+        self.depth += 1
+
+    def on_end(self, event):
+        self.depth -= 1
+        if self.depth == 0:
+            self.seconds += time.perf_counter() - self.started
+
+    def take(self) -> float:
+        """The seconds counted since the last call (s)."""
+        seconds, self.seconds = self.seconds, 0.0
+        return seconds
+
+    def register(self) -> "FirstUseClock":
+        """Start counting (numba's event listener)."""
+        from numba.core import event
+        self._listener = type("_Listener", (event.Listener,),
+                              {"on_start": lambda _, e: self.on_start(e),
+                               "on_end": lambda _, e: self.on_end(e)})()
+        event.register("numba:compile", self._listener)
+        return self
+
+    def unregister(self) -> None:
+        from numba.core import event
+        event.unregister("numba:compile", self._listener)
+
+
+#: Counts first-use compiles once a process runs with ``WORKBENCH_COMPILE_JOBS=0``.
+_first_use: list = []
+
+
 def _kernel_name(kernel) -> str:
     function = getattr(kernel, "py_func", kernel)      # plain Python under NUMBA_DISABLE_JIT
     return f"{function.__module__.rsplit('.', 1)[-1]}.{function.__name__}"
@@ -649,7 +698,11 @@ def prepare_kernels(kernel) -> None:
     _prepared.add(_kernel_name(kernel))
     roots = (_kernel_name(kernel), *_RUN_KERNELS)
     jobs = compile_plan.jobs_from_environment()
-    if jobs == 0 or not compile_plan.missing(compile_plan.closure(compile_plan.load_plan(), roots)):
+    if jobs == 0:
+        if not _first_use:
+            _first_use.append(FirstUseClock().register())
+        return
+    if not compile_plan.missing(compile_plan.closure(compile_plan.load_plan(), roots)):
         return
     print(f"workbench: compiling the numba kernels ({COMPILE_NOTE}; once, then cached in "
           f"{CACHE_DIR})", file=sys.stderr, flush=True)
