@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba.core import event as numba_event
 
 from . import packing as mdl
 from ..core import excitation as cx, layout as ly
@@ -634,7 +635,7 @@ _prepared: set = set()
 _compile_unreported: dict = {}
 
 
-class FirstUseClock:
+class FirstUseClock(numba_event.Listener):
     """Seconds numba spends compiling kernels on their first use in this process,
     counted from numba's ``numba:compile`` events (a caller's compile includes
     its callees': nested compiles count once), until :meth:`take` reads them.
@@ -663,17 +664,12 @@ class FirstUseClock:
         return seconds
 
     def register(self) -> "FirstUseClock":
-        """Start counting (numba's event listener)."""
-        from numba.core import event
-        self._listener = type("_Listener", (event.Listener,),
-                              {"on_start": lambda _, e: self.on_start(e),
-                               "on_end": lambda _, e: self.on_end(e)})()
-        event.register("numba:compile", self._listener)
+        """Start counting."""
+        numba_event.register("numba:compile", self)
         return self
 
     def unregister(self) -> None:
-        from numba.core import event
-        event.unregister("numba:compile", self._listener)
+        numba_event.unregister("numba:compile", self)
 
 
 #: Counts first-use compiles once a process runs with ``WORKBENCH_COMPILE_JOBS=0``.
