@@ -1,7 +1,6 @@
 """Accuracy against cost of the integration methods on 1 s runs across the operating range.
 
     python benchmarks/controlled_accuracy.py run /tmp/acc.json [--cases issue|range|all] [--tols 1e-4,1e-5]
-        [--max-segment-steps N]
     python benchmarks/controlled_accuracy.py table /tmp/acc.json
 
 Each case runs 1 s from the static equilibrium with a 0.5 s soft start and
@@ -10,11 +9,10 @@ converged solution, whose own error is its difference from a 32nd, printed
 as ``ref_err``): the tip height's largest difference over the converged
 tip's range, the largest difference of a contact code's time share (from
 the event log, ``regimes.contact_shares_of``), and the events in the
-window.  Methods: fixed RK4 at the default step, at a half and a quarter of
-it, and the controlled method at each tolerance, with its wall time, its
-lattice steps (accepted and in all) and its own largest error estimate.
-``--max-segment-steps`` caps the control interval (base steps; the
-default is ``methods.MAX_SEGMENT_STEPS``) to measure other interval lengths.
+window.  Methods: fixed RK4 at the default step, at a half, a quarter and
+an eighth of it, and the default (controlled) method at each tolerance,
+with its wall time, its steps (accepted and in all) and its own largest
+error estimate.
 ``table`` prints the saved results as Markdown, and for each tolerance the
 ratio to the measured error (the larger of the tip's and the shares') of
 the run's global error estimate and of its difference from its companion
@@ -84,10 +82,7 @@ def compare(run, ref) -> dict:
             "events_ref": d["events_ref"], "event_err": d["event_error"]}
 
 
-def measure(name, params, ex, tols, max_segment_steps=None):
-    if max_segment_steps is not None:
-        from workbench.model import methods
-        methods.MAX_SEGMENT_STEPS = max_segment_steps
+def measure(name, params, ex, tols):
     dt = default_dt(params, ex)
     ref = simulate(params, ex, DURATION_S, dt=dt / CONVERGED_DIVISOR)
     half_ref = simulate(params, ex, DURATION_S, dt=dt / (CONVERGED_DIVISOR // 2))
@@ -119,7 +114,6 @@ def main(argv=None):
     ap.add_argument("--cases", choices=("issue", "range", "all"), default="issue")
     ap.add_argument("--tols", default="1e-4")
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--max-segment-steps", type=int, default=None)
     args = ap.parse_args(argv)
     if args.what == "run":
         cases = {}
@@ -128,7 +122,7 @@ def main(argv=None):
         if args.cases in ("range", "all"):
             cases.update(range_cases())
         tols = [float(x) for x in args.tols.split(",")]
-        done = Parallel(n_jobs=args.jobs)(delayed(measure)(n, p, ex, tols, args.max_segment_steps)
+        done = Parallel(n_jobs=args.jobs)(delayed(measure)(n, p, ex, tols)
                                           for n, (p, ex) in cases.items())
         rows = [r for part in done for r in part]
         with open(args.file, "w") as f:

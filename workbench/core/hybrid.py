@@ -26,13 +26,14 @@ step is integrated again in the new regime.
 Transitions (:mod:`workbench.core.transitions`): an impact is a momentum
 transfer by Moreau's impact law over every closed or closing point; after
 every event the new regime is chosen by the acceleration-level
-enumeration.  Impacts that recur within ACCUM_STEPS steps, or close slower
-than the gap's free acceleration makes in ACCUM_STEPS steps, are an
+enumeration.  Impacts that recur within ACCUM_TIME_S, or close slower
+than the gap's free acceleration makes in ACCUM_TIME_S, are an
 accumulation: the impact set then takes every point within ACCUM_GAP_TOL,
 so the micro-collisions end in the persistent contact.  A watched gap
 that is already closed is an impact only while it approaches faster than
-CLOSED_RATE.  More than MAX_EVENTS_PER_STEP events in one step hand the
-rest of the step and STEPPED_STEPS more to Moreau-Jean time-stepping
+CLOSED_RATE.  More than FLOOD_EVENTS events within FLOOD_WINDOW_S (or
+MAX_EVENTS_PER_STEP in one step) hand the rest of the step and the steps
+covering STEPPED_TIME_S to Moreau-Jean time-stepping
 (:func:`workbench.core.transitions.moreau_jean_step`, in sub-steps of at
 most P[P_STEPPED_DT]).  Each event is
 written to the log (layout ``LOG_*``); failures (NaN, a mass matrix that
@@ -44,47 +45,19 @@ import math
 import numba as nb
 import numpy as np
 
-from .config import (ACCUM_GAP_TOL, ACCUM_STEPS, CLOSED_RATE, EVENT_TIME_TOL, GAP_TOL,
-                     GRAZE_BRACKET, GRAZE_ITERS, GRAZE_MARGIN, JIT, JIT_INLINE, LAMBDA_EPS,
-                     MAX_EVENTS_PER_STEP, RATE_EPS, STEP_REMAINDER_REL, STEPPED_STEPS)
+from .config import (ACCUM_GAP_TOL, ACCUM_TIME_S, CLOSED_RATE, EVENT_TIME_TOL, FLOOD_EVENTS,
+                     FLOOD_WINDOW_S, GAP_TOL, GRAZE_BRACKET, GRAZE_ITERS, GRAZE_MARGIN, JIT,
+                     JIT_INLINE, LAMBDA_EPS, MAX_EVENTS_PER_STEP, RATE_EPS, STEP_REMAINDER_REL,
+                     STEPPED_TIME_S)
 from . import layout as ly
 from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
 from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
 from .dynamics import rhs
 from .integrate import rk_step
+from .event_functions import event_values
+from .pair import dense
 from .sensors import fill_signals
 from .transitions import choose_regime, impact, moreau_jean_step
-
-
-@nb.njit(**JIT)
-def event_values(y, P, free, cg, rg, ev, row, rate_row):
-    """Event functions of the regime in rg at y into ev[row] (gap rates into ev[rate_row]).
-
-    The contact forces in rg must be those of y (rhs_regime just ran).
-    """
-    fill_geometry(y, P, cg)
-    qd = y[ly.N_DOF:ly.N_STATE]
-    set_index = int(rg[ly.RG_SET])
-    stick = rg[ly.RG_STICK] != 0.0
-    double_stick = stick and ly.SET_SECOND[set_index] >= 0
-    for p in range(ly.N_POINTS):
-        if in_set(set_index, p):
-            ev[row, ly.EV_GAP + p] = 1.0
-            ev[rate_row, ly.EV_GAP + p] = 0.0
-            # a sticking double contact watches its split of forces in EV_STICK
-            ev[row, ly.EV_LAMBDA + p] = 1.0 if double_stick else rg[ly.RG_LN + p] + LAMBDA_EPS
-        else:
-            ev[row, ly.EV_GAP + p] = cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p]
-            ev[rate_row, ly.EV_GAP + p] = row_rate(cg, ly.CG_G + p, qd)
-            ev[row, ly.EV_LAMBDA + p] = 1.0
-    ev[row, ly.EV_STICK] = 1.0
-    ev[row, ly.EV_SLIP] = 1.0
-    if set_index > 0:
-        if stick:
-            ev[row, ly.EV_STICK] = stick_margin(P, free, cg, rg) + stick_tolerance(P, rg)
-        else:
-            rate = row_rate(cg, ly.CG_T + tangent_point(set_index), qd)
-            ev[row, ly.EV_SLIP] = rg[ly.RG_SIGN] * rate + RATE_EPS
 
 
 @nb.njit(**JIT_INLINE)
@@ -100,12 +73,21 @@ def _copy_ev(ev, src, dst):
 
 
 @nb.njit(**JIT_INLINE)
-def _trial(theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
-    """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY."""
+def _trial(theta, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+    """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY.
+
+    ``on_dense``: the state is the dense output of the step just taken (its
+    stages intact, :func:`workbench.core.pair.dense`); else a step of theta h
+    is integrated from the step's start.
+    """
     y = stages[ly.STAGE_CUR]
     y_try = stages[ly.STAGE_TRY]
-    status = rk_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                     rg, y_try)
+    status = ly.OK
+    if on_dense:
+        dense(theta, h, y, P, stages, y_try)
+    else:
+        status = rk_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                         rg, y_try)
     if status == ly.OK:
         status = rhs_regime(t + theta * h, y_try, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
                             rg, stages[ly.STAGE_KTRY])
@@ -172,7 +154,8 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
     for _ in range(GRAZE_ITERS):
         if not (0.0 < x < before):
             return ly.OK, -1.0
-        status = _trial(x, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
+        status = _trial(x, t, h, np.bool_(False), P, tab, kc, free, ex, rec, mat, vec, stages,
+                        cg, cw, rg, ev)
         if status != ly.OK:
             return status, -1.0
         f = ev[ly.EV_TRY, e]
@@ -194,7 +177,8 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
 
 
 @nb.njit(**JIT)
-def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def _bracket(e, flo, hi, fhi, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+             rg, ev):
     """Locate event e's sign change in (0, hi) by Brent's method, to EVENT_TIME_TOL.
 
     Brent's zeroin (R. P. Brent, Algorithms for Minimization without
@@ -207,7 +191,7 @@ def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages,
     always an end of the bracket.
 
     ``flo`` >= 0 is its value at the step's start, ``fhi`` < 0 at ``hi``,
-    whose state is in STAGE_HI.  Returns ``(status, theta)``: the state just
+    whose state is in STAGE_HI.  Trial states as :func:`_trial` (``on_dense``).  Returns ``(status, theta)``: the state just
     past the change (theta) is left in STAGE_HI, the events there in EV_HI.
     """
     half_tol = 0.5 * EVENT_TIME_TOL / h
@@ -252,7 +236,8 @@ def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages,
             b += d
         else:
             b += half_tol if xm > 0.0 else -half_tol
-        status = _trial(b, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev)
+        status = _trial(b, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                        rg, ev)
         if status != ly.OK:
             return status, hi
         fb = ev[ly.EV_TRY, e]
@@ -266,13 +251,54 @@ def _bracket(e, flo, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages,
     return ly.OK, (b if fb < 0.0 else c)
 
 
+#: Where the dense output of a step is checked for an event whose function is
+#: positive at both ends of the step (fractions of the step).
+SCAN_POINTS = (0.2, 0.4, 0.5, 0.6, 0.8)
+
+
 @nb.njit(**JIT)
-def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+    """Is event e negative somewhere inside the step though positive at both ends? (dense output)
+
+    Called when a sign check flagged it: e's smallest value over the step's
+    stages is negative (ev[EV_MIN]), or e is a gap that turns within the
+    step.  The dense output is evaluated at the SCAN_POINTS before ``before``
+    and, for a turning gap, where its cubic Hermite interpolant of the ends
+    is smallest.  Returns ``(status, theta)``: the first theta whose state
+    is past the change (in STAGE_HI, its events in EV_HI), or -1.
+    """
+    xs = SCAN_POINTS
+    x_min = -1.0
+    if e < ly.EV_GAP + ly.N_POINTS:
+        m0 = h * ev[ly.EV_RATE_START, e]
+        m1 = h * ev[ly.EV_RATE_END, e]
+        if m0 < 0.0 and m1 > 0.0:
+            x_min, _ = _hermite_min(ev[ly.EV_START, e], ev[ly.EV_END, e], m0, m1)
+    for k in range(len(xs) + 1):
+        x = x_min if k == 0 else xs[k - 1]
+        if not (0.0 < x < before):
+            continue
+        status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+                        cw, rg, ev)
+        if status != ly.OK:
+            return status, -1.0
+        if ev[ly.EV_TRY, e] < 0.0:
+            _copy(stages, ly.STAGE_TRY, ly.STAGE_HI)
+            _copy_ev(ev, ly.EV_TRY, ly.EV_HI)
+            return ly.OK, x
+    return ly.OK, -1.0
+
+
+@nb.njit(**JIT)
+def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """The earliest event in the step (t, t + h) from STAGE_CUR to STAGE_NEXT.
 
-    Returns ``(status, event, theta)``: event -1 if none; else the state
-    just past the event (within EVENT_TIME_TOL) is in STAGE_HI at
-    t + theta h.
+    ``on_dense``: trial states are the dense output of the step just taken,
+    and an event positive at both ends is looked for by :func:`_scan`;
+    else they are integrated from the step's start, and a grazing gap is
+    looked for by :func:`_graze`.  Returns ``(status, event, theta)``:
+    event -1 if none; else the state just past the event (within
+    EVENT_TIME_TOL) is in STAGE_HI at t + theta h.
     """
     best = -1
     best_theta = 2.0
@@ -286,6 +312,17 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
         if f1 < 0.0:
             hi = 1.0
             fhi = f1
+        elif on_dense:
+            turning = (e < ly.EV_GAP + ly.N_POINTS and ev[ly.EV_RATE_START, e] < 0.0
+                       and ev[ly.EV_RATE_END, e] > 0.0 and f0 < 1.0)
+            if turning or ev[ly.EV_MIN, e] < 0.0:
+                status, x = _scan(e, t, h, best_theta, P, tab, kc, free, ex, rec, mat, vec, stages,
+                                  cg, cw, rg, ev)
+                if status != ly.OK:
+                    return status, -1, 0.0
+                if x >= 0.0:
+                    hi = x
+                    fhi = ev[ly.EV_HI, e]
         elif e < ly.EV_GAP + ly.N_POINTS and f0 < 1.0:
             # grazing: the gap's cubic Hermite interpolant over the step
             m0 = h * ev[ly.EV_RATE_START, e]
@@ -309,8 +346,8 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
         elif hi == 1.0:
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
-        status, hi = _bracket(e, f0, hi, fhi, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
-                              cw, rg, ev)
+        status, hi = _bracket(e, f0, hi, fhi, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec,
+                              stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, -1, 0.0
         best = e
@@ -329,8 +366,8 @@ def locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
         if earlier < 0:
             break
         status, hi = _bracket(earlier, ev[ly.EV_START, earlier], best_theta,
-                              ev[ly.EV_HI, earlier], t, h, P, tab, kc, free, ex, rec, mat, vec,
-                              stages, cg, cw, rg, ev)
+                              ev[ly.EV_HI, earlier], t, h, on_dense, P, tab, kc, free, ex, rec,
+                              mat, vec, stages, cg, cw, rg, ev)
         if status != ly.OK:
             return status, -1, 0.0
         best = earlier
@@ -362,25 +399,25 @@ def _log(log, n_log, t, kind, reg_from, reg_to, point):
 
 
 @nb.njit(**JIT)
-def _accumulating(t, y, point, P, cg, st, dt, k1):
+def _accumulating(t, y, point, P, cg, st, k1):
     """Whether an impact of ``point`` at t belongs to an accumulation (docs/model.md §7).
 
-    Impacts recurring within ACCUM_STEPS steps, or a closing rate below
-    what the free gap acceleration makes in ACCUM_STEPS steps.
+    Impacts recurring within ACCUM_TIME_S, or a closing rate below what the
+    free gap acceleration makes in ACCUM_TIME_S.
     """
-    if t - st[ly.ST_T_IMPACT] < ACCUM_STEPS * dt:
+    if t - st[ly.ST_T_IMPACT] < ACCUM_TIME_S:
         return True
     fill_geometry(y, P, cg)
     qd = y[ly.N_DOF:ly.N_STATE]
     rate = row_rate(cg, ly.CG_G + point, qd)
     acc = row_rate(cg, ly.CG_G + point, k1[ly.N_DOF:ly.N_STATE]) + row_convective(
         cg, ly.CG_G + point, qd)
-    return abs(rate) < ACCUM_STEPS * abs(acc) * dt
+    return abs(rate) < ACCUM_TIME_S * abs(acc)
 
 
 @nb.njit(**JIT)
-def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, log,
-                n_log, st):
+def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, log, n_log,
+                st):
     """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
 
     Returns a status; the log row n_log is written.
@@ -401,11 +438,11 @@ def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, r
     lost = 0.0
     if e < ly.EV_GAP + ly.N_POINTS:
         p = e - ly.EV_GAP
-        accumulating = _accumulating(t, y, p, P, cg, st, dt, k1)
+        accumulating = _accumulating(t, y, p, P, cg, st, k1)
         close_within = 0.0
         if accumulating:
             gap_tol = ACCUM_GAP_TOL
-            close_within = ACCUM_STEPS * dt
+            close_within = ACCUM_TIME_S
         free_acc = stages[ly.STAGE_TRY]
         status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, free_acc)
         if status != ly.OK:
@@ -458,6 +495,16 @@ def apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, r
 
 
 @nb.njit(**JIT_INLINE)
+def flooding(st, t):
+    """Count an event at t; True when it is more than FLOOD_EVENTS within FLOOD_WINDOW_S."""
+    if t - st[ly.ST_FLOOD_T0] > FLOOD_WINDOW_S:
+        st[ly.ST_FLOOD_T0] = t
+        st[ly.ST_FLOOD_N] = 0.0
+    st[ly.ST_FLOOD_N] += 1.0
+    return st[ly.ST_FLOOD_N] > FLOOD_EVENTS
+
+
+@nb.njit(**JIT_INLINE)
 def _immediate_impact(ev):
     """A watched gap already closed and closing faster than CLOSED_RATE (-1 if none)."""
     for p in range(ly.N_POINTS):
@@ -493,9 +540,10 @@ def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, 
 
 
 @nb.njit(**JIT)
-def _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
-           out_t, out_y, out_sig):
-    y = stages[ly.STAGE_CUR]
+def store(stored, t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
+          out_t, out_y, out_sig):
+    """Sample ``stored``: the state y at t in the regime of rg, and its signals (rg's
+    forces and STAGE_KTRY are overwritten)."""
     k = stages[ly.STAGE_KTRY]
     status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k)
     if status != ly.OK:
@@ -521,6 +569,7 @@ def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
     reg_start = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
     if step0 == 0:
         st[ly.ST_T_IMPACT] = -1e300
+        st[ly.ST_FLOOD_T0] = -1e300
         st[ly.ST_S_MIN] = y[ly.S]
         st[ly.ST_S_MAX] = y[ly.S]
     status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
@@ -532,8 +581,8 @@ def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
         _log(log, n_log, t, ly.KIND_START, reg_start,
              regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
         n_log += 1
-        status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
-                        out_t, out_y, out_sig)
+        status = store(stored, t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+                       st, out_t, out_y, out_sig)
         if status != ly.OK:
             return status, stored, n_log
         stored += 1
@@ -545,9 +594,8 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
             ev, log, n_log, st):
     """One step of the lattice, from (t, STAGE_CUR) to t_end, with its events.
 
-    ``dt`` (s) is the lattice step (the accumulation rule counts in it);
-    ``stepped_left`` the Moreau-Jean steps still to take after an event
-    flood.  The event log must have room for MAX_EVENTS_PER_STEP + 2 rows
+    ``dt`` (s) is the lattice step; ``stepped_left`` the Moreau-Jean steps
+    still to take after an event flood (those covering STEPPED_TIME_S).  The event log must have room for MAX_EVENTS_PER_STEP + 2 rows
     from n_log.  Returns ``(status, t, n_log, stepped_left)``; on success
     t == t_end and STAGE_CUR, STAGE_K1 and the events' start rows are at t.
     """
@@ -578,8 +626,8 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
             if status != ly.OK:
                 return status, t, n_log, stepped_left
             event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-            status, e, theta = locate(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                      rg, ev)
+            status, e, theta = locate(t, h, np.bool_(False), P, tab, kc, free, ex, rec, mat, vec,
+                                      stages, cg, cw, rg, ev)
             if status != ly.OK:
                 return status, t, n_log, stepped_left
             if e < 0:
@@ -598,9 +646,9 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
                                  10 + p)
         while e >= 0:
             n_step_events += 1
-            if n_step_events > MAX_EVENTS_PER_STEP:
+            if flooding(st, t) or n_step_events > MAX_EVENTS_PER_STEP:
                 # an episode the event-driven logic cannot resolve: Moreau-Jean
-                # time-stepping through the rest of this step and STEPPED_STEPS more
+                # time-stepping through the rest of this step and STEPPED_TIME_S more
                 status = ly.OK
                 if t_end - t > STEP_REMAINDER_REL * dt:
                     status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages,
@@ -609,9 +657,9 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
                     st[ly.ST_T] = t
                     return status, t, n_log, stepped_left
                 t = t_end
-                stepped_left = STEPPED_STEPS
+                stepped_left = int(math.ceil(STEPPED_TIME_S / dt - 1e-9))
                 break
-            status = apply_event(e, t, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+            status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
                                  rg, ev, log, n_log, st)
             if status != ly.OK:
                 st[ly.ST_T] = t
@@ -667,8 +715,8 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
             return status, stored, n_log
         st[ly.ST_STEP] = step0 + step
         if (step0 + step) % decim == 0:
-            status = _store(stored, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
-                            out_t, out_y, out_sig)
+            status = store(stored, t, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec,
+                           stages, cg, cw, rg, st, out_t, out_y, out_sig)
             if status != ly.OK:
                 return status, stored, n_log
             stored += 1

@@ -68,14 +68,21 @@ P_STEPPED_DT = 42  # largest Moreau-Jean step (s); inf until simulate sets it fr
 P_CORK_FORM = 43   # cork law's form: its index in workbench.core.cork.FORMS (stored as a float)
 # The step method: the explicit Runge-Kutta tableau (Butcher's c, A, b) that
 # every integrator steps with (workbench.core.integrate.rk_step); written by
-# workbench.model.tableaus.write_tableau (classical RK4 by default).
-MAX_RK_STAGES = 6
+# workbench.model.tableaus.write_tableau (classical RK4 by default).  An
+# embedded pair (workbench.core.pair) adds its error weights e and its dense
+# output's coefficients (zeros for a tableau without them).
+MAX_RK_STAGES = 7
+#: Powers theta^1 .. theta^MAX_DENSE_DEGREE of a dense output's weights.
+MAX_DENSE_DEGREE = 5
 P_RK_STAGES = 44   # number of stages s (stored as a float)
 P_RK_ORDER = 45    # order p: global error O(dt^p) (the controller's Richardson factor 2^p - 1)
 P_RK_C = 46        # P_RK_C + i: node c_i (-), i < MAX_RK_STAGES
 P_RK_B = P_RK_C + MAX_RK_STAGES   # P_RK_B + i: weight b_i (-)
 P_RK_A = P_RK_B + MAX_RK_STAGES   # P_RK_A + MAX_RK_STAGES i + j: coefficient a_ij (-), j < i
-N_PARAMS = P_RK_A + MAX_RK_STAGES * MAX_RK_STAGES
+P_RK_E = P_RK_A + MAX_RK_STAGES * MAX_RK_STAGES   # P_RK_E + i: error weight e_i = b_i - bhat_i (-)
+P_RK_D = P_RK_E + MAX_RK_STAGES   # P_RK_D + MAX_DENSE_DEGREE i + j: dense weight of k_i, theta^(j+1)
+P_RK_DEGREE = P_RK_D + MAX_RK_STAGES * MAX_DENSE_DEGREE   # the dense output's degree (0: none)
+N_PARAMS = P_RK_DEGREE + 1
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):
@@ -171,9 +178,10 @@ N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer 
 # found past an event), STAGE_KNEXT and STAGE_KTRY the right-hand sides at
 # STAGE_NEXT and STAGE_TRY; STAGE_QD holds q'- in [0, 9) and a candidate
 # q'+ in [9, 18) during an impact.
+# STAGE_ERR holds an embedded pair's error estimate of the step (workbench.core.pair).
 (STAGE_TMP, STAGE_CUR, STAGE_NEXT, STAGE_K1, STAGE_TRY, STAGE_HI, STAGE_KNEXT, STAGE_KTRY,
- STAGE_QD) = range(MAX_RK_STAGES, MAX_RK_STAGES + 9)
-N_STAGES = MAX_RK_STAGES + 9
+ STAGE_QD, STAGE_ERR) = range(MAX_RK_STAGES, MAX_RK_STAGES + 10)
+N_STAGES = MAX_RK_STAGES + 10
 
 # --- augmented state -----------------------------------------------------------
 # The integrators carry (q, q') and these running integrals (erg), integrated
@@ -243,9 +251,10 @@ N_CW_COLS = N_LAW_COLS
 # Event values ev (N_EV_ROWS, N_EV): every event function changes sign from
 # + to - when its event happens; functions not watched in a regime are +1.
 # Rows: values at the step's start, end, a trial point, the earliest point
-# found past an event (HI); gap rates at the start, end and trial point.
-EV_START, EV_END, EV_TRY, EV_HI, EV_RATE_START, EV_RATE_END, EV_RATE_TRY = range(7)
-N_EV_ROWS = 7
+# found past an event (HI); gap rates at the start, end and trial point;
+# (EV_MIN) the smallest value of each force event over a step's stages.
+EV_START, EV_END, EV_TRY, EV_HI, EV_RATE_START, EV_RATE_END, EV_RATE_TRY, EV_MIN = range(8)
+N_EV_ROWS = 8
 EV_GAP = 0                   # EV_GAP + k: open gap g_k (impact); rates hold g_k'
 EV_LAMBDA = EV_GAP + N_POINTS  # EV_LAMBDA + k: lambda_n of active point k (separation)
 EV_STICK = EV_LAMBDA + N_POINTS  # mu_s sum lambda_n - |lambda_t| (stick -> slip)
@@ -288,7 +297,10 @@ ST_T_IMPACT = 16     # time of the last impact (s)
 ST_MAX_CORRECTION = 17   # largest |g| of an active gap before its projection (cm)
 ST_T_MAX_PEN = 18    # time of the largest penetration (s)
 ST_PEN_WHERE = 19    # where it was found: 10 x (1 event bracket, 2 step end) + point (0..3)
-N_ST = 20
+ST_FLOOD_T0 = 20     # start of the window in which events are counted for a flood (s)
+ST_FLOOD_N = 21      # events in that window
+ST_STEPPED_UNTIL = 22    # Moreau-Jean time-stepping runs until this time (s) after a flood
+N_ST = 23
 
 # --- the error-controlled integration (workbench.core.controlled) --------------
 # Snapshots snap (N_SNAP, N_AUG): an interval's start and the end of its
@@ -321,7 +333,12 @@ N_CTL_LEVELS = 10
 # its scale) per interval, and each event's time error (s).
 CTL_Q_SSQ = CTL_LEVELS + N_CTL_LEVELS
 CTL_T_SSQ = CTL_Q_SSQ + 1
-N_CTL = CTL_Q_SSQ + 2
+# The embedded pair's controller (workbench.core.adaptive) between calls: the
+# next step to try (s; 0 before the first) and the last accepted estimate
+# over the tolerance (the PI controller's memory).
+CTL_H_NEXT = CTL_T_SSQ + 1
+CTL_ERR_PREV = CTL_H_NEXT + 1
+N_CTL = CTL_ERR_PREV + 1
 # Error scales scale (2, N_STATE): row SCALE_FLOOR the smallest scale of each
 # component of (q, q'), row SCALE_PEAK its largest |value| so far.
 SCALE_FLOOR, SCALE_PEAK = 0, 1

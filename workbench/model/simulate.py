@@ -28,7 +28,7 @@ from ..core import excitation as cx, layout as ly
 from . import accuracy, antialias, drives
 from .drives import none
 from .tableaus import write_tableau
-from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS, segment_steps
+from .methods import DEFAULT_LEVEL_MAX, DEFAULT_METHOD, FLOOR_LOG_ROWS, METHODS
 from .limits import DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MIN_DT, STABILITY_MARGIN, TOL_RANGE
 from .params import ParameterError, Parameters, check_positive
 from .regimes import contact_code, contact_shares_of, in_contact, is_stick, set_of
@@ -174,8 +174,6 @@ CONTACT_STAT_KEYS = ("accumulations", "accumulation_energy_lost_erg", "inconsist
 
 _CHUNK_S = 1.0
 _LOG_ROWS = 8192
-#: The controlled method's log holds both paths of an interval at its finest level.
-_LOG_ROWS_CONTROLLED = 65536
 #: Intervals accepted at the finest level listed in :meth:`Run.summary` (all are in ``control``).
 SUMMARY_FLOOR_ROWS = 20
 
@@ -462,15 +460,13 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     m = decim // k
     decimator = antialias.Decimator(m, 1.0 / (k * dt))
     if METHODS[method].controlled:
-        seg = segment_steps(decim, n_steps)
         ctl = np.zeros(ly.N_CTL)
         ctl[ly.CTL_H_MIN] = np.inf
-        controller = (np.zeros((ly.N_SNAP, ly.N_AUG)), ctl, np.zeros((ly.N_SCALE_ROWS, ly.N_STATE)),
+        controller = (ctl, np.zeros((ly.N_SCALE_ROWS, ly.N_STATE)),
                       np.zeros((FLOOR_LOG_ROWS, ly.N_FLOOR)))
-        settings = (seg, tol, int(level_max))
-        log_rows = _LOG_ROWS_CONTROLLED
+        settings = (tol, int(level_max))
     else:
-        controller, settings, log_rows = (), (), _LOG_ROWS
+        controller, settings = (), ()
     parts_t, parts_y, parts_s, parts_log = [], [], [], []
     done = 0
     status = ly.OK
@@ -495,7 +491,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         out_t = np.empty(n_out)
         out_y = np.empty((n_out, ly.N_STATE))
         out_sig = np.empty((n_out, ly.N_SIG))
-        log = np.empty((log_rows, ly.N_LOG))
+        log = np.empty((_LOG_ROWS, ly.N_LOG))
         status, stored, n_log = kernel(y, t0 + done * dt, dt, n, done, k, *settings, *model, ex,
                                        *work, out_t, out_y, out_sig, log, st, *controller)
         keep = slice((-n_internal) % m, stored, m)
@@ -530,7 +526,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     run.anti_alias = antialias.summary(m, 1.0 / (k * dt))
     run.method = method
     run.tol = tol
-    run.control = (control_summary(controller[1], controller[3], tol, dt, duration) if controller
+    run.control = (control_summary(controller[0], controller[2], tol, dt, duration) if controller
                    else fixed_step_summary(dt, int(st[ly.ST_STEP])))
     if check_accuracy and run.ok:
         finer = accuracy.companion_settings(METHODS[method].controlled, tol, dt)

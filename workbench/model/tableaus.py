@@ -11,8 +11,11 @@ needs no new kernel and no compile.  A method of
 
 Each tableau is checked when it is made: at most MAX_RK_STAGES stages,
 strictly lower-triangular A, c_i = sum_j a_ij, and Butcher's order
-conditions up to its order (checked up to order 4; Hairer, Norsett &
+conditions up to its order (checked up to order 5; Hairer, Norsett &
 Wanner, Solving Ordinary Differential Equations I, 2nd ed., Table II.2.2).
+An embedded pair (:class:`Pair`, :mod:`workbench.core.pair`) adds the error
+weights e = b - bhat of its embedded solution (bhat checked to its order)
+and its dense output's weights (equal to b at theta = 1), and is FSAL.
 """
 from __future__ import annotations
 
@@ -33,9 +36,18 @@ _CONDITIONS = (
     (4, lambda b, c, a: (b * c) @ a @ c, 1.0 / 8.0),
     (4, lambda b, c, a: b @ a @ c ** 2, 1.0 / 12.0),
     (4, lambda b, c, a: b @ a @ a @ c, 1.0 / 24.0),
+    (5, lambda b, c, a: b @ c ** 4, 1.0 / 5.0),
+    (5, lambda b, c, a: (b * c ** 2) @ a @ c, 1.0 / 10.0),
+    (5, lambda b, c, a: (b * c) @ a @ c ** 2, 1.0 / 15.0),
+    (5, lambda b, c, a: (b * c) @ a @ a @ c, 1.0 / 30.0),
+    (5, lambda b, c, a: b @ (a @ c) ** 2, 1.0 / 20.0),
+    (5, lambda b, c, a: b @ a @ c ** 3, 1.0 / 20.0),
+    (5, lambda b, c, a: b @ a @ (c * (a @ c)), 1.0 / 40.0),
+    (5, lambda b, c, a: b @ a @ a @ c ** 2, 1.0 / 60.0),
+    (5, lambda b, c, a: b @ a @ a @ a @ c, 1.0 / 120.0),
 )
 #: The largest order whose conditions are checked.
-CHECKED_ORDER = 4
+CHECKED_ORDER = 5
 #: Tolerance of the checks (the coefficients are rounded to doubles).
 _EPS = 1e-13
 
@@ -65,10 +77,7 @@ class Tableau:
         b, c, a = np.array(self.b), np.array(self.c), self.matrix()
         if np.abs(a.sum(axis=1) - c).max() > _EPS:
             raise ValueError(f"tableau {self.name!r}: c_i must equal sum_j a_ij")
-        for order, value, exact in _CONDITIONS:
-            if order <= self.order and abs(value(b, c, a) - exact) > _EPS:
-                raise ValueError(f"tableau {self.name!r} misses an order-{order} condition "
-                                 f"(sum {value(b, c, a):.15g}, needs {exact:.15g})")
+        _check_order(self.name, b, c, a, self.order)
 
     @property
     def stages(self) -> int:
@@ -82,10 +91,46 @@ class Tableau:
         return a
 
 
+def _check_order(name, b, c, a, order):
+    for k, value, exact in _CONDITIONS:
+        if k <= order and abs(value(b, c, a) - exact) > _EPS:
+            raise ValueError(f"tableau {name!r} misses an order-{k} condition "
+                             f"(sum {value(b, c, a):.15g}, needs {exact:.15g})")
+
+
+@dataclass(frozen=True)
+class Pair(Tableau):
+    """An FSAL embedded pair with a dense output: ``e`` the error weights b - bhat,
+    ``dense[i]`` the weights of k_i as coefficients of theta^1, theta^2, ..."""
+    e: tuple[float, ...] = ()
+    embedded_order: int = 0
+    dense: tuple[tuple[float, ...], ...] = ()
+
+    def __post_init__(self):
+        super().__post_init__()
+        s = self.stages
+        b, c, a = np.array(self.b), np.array(self.c), self.matrix()
+        if len(self.e) != s or len(self.dense) != s:
+            raise ValueError(f"pair {self.name!r}: e and dense need {s} rows")
+        degree = len(self.dense[0])
+        if not 1 <= degree <= ly.MAX_DENSE_DEGREE or any(len(r) != degree for r in self.dense):
+            raise ValueError(f"pair {self.name!r}: dense weights of one degree, 1 to "
+                             f"{ly.MAX_DENSE_DEGREE}")
+        if b[-1] != 0.0 or c[-1] != 1.0 or np.abs(a[-1, :-1] - b[:-1]).max() > _EPS:
+            raise ValueError(f"pair {self.name!r}: the last stage must be f(t + h, y_new) (FSAL)")
+        _check_order(self.name, b - np.array(self.e), c, a, self.embedded_order)
+        if np.abs(np.sum(self.dense, axis=1) - b).max() > _EPS:
+            raise ValueError(f"pair {self.name!r}: the dense weights must equal b at theta = 1")
+
+    @property
+    def degree(self) -> int:
+        return len(self.dense[0])
+
+
 def write_tableau(P: np.ndarray, tableau: Tableau) -> None:
     """Put ``tableau`` into the parameter array P at layout ``P_RK_*``."""
     m = ly.MAX_RK_STAGES
-    P[ly.P_RK_STAGES:ly.P_RK_A + m * m] = 0.0
+    P[ly.P_RK_STAGES:ly.N_PARAMS] = 0.0
     P[ly.P_RK_STAGES] = tableau.stages
     P[ly.P_RK_ORDER] = tableau.order
     for i in range(tableau.stages):
@@ -93,6 +138,12 @@ def write_tableau(P: np.ndarray, tableau: Tableau) -> None:
         P[ly.P_RK_B + i] = tableau.b[i]
         for j, a_ij in enumerate(tableau.a[i]):
             P[ly.P_RK_A + m * i + j] = a_ij
+    if isinstance(tableau, Pair):
+        P[ly.P_RK_DEGREE] = tableau.degree
+        for i in range(tableau.stages):
+            P[ly.P_RK_E + i] = tableau.e[i]
+            for j, d in enumerate(tableau.dense[i]):
+                P[ly.P_RK_D + ly.MAX_DENSE_DEGREE * i + j] = d
 
 
 #: Classical fourth-order Runge-Kutta (Kutta 1901; Hairer, Norsett & Wanner,
@@ -101,3 +152,29 @@ RK4 = Tableau("rk4", c=(0.0, 0.5, 0.5, 1.0),
               a=((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0)),
               b=(1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0), order=4,
               source="Kutta (1901); Hairer, Norsett & Wanner, Table II.1.2")
+
+
+_DP5_B = (35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84)
+#: Dormand & Prince 5(4) (J. R. Dormand, P. J. Prince, J. Comput. Appl. Math. 6, 1980; Hairer,
+#: Norsett & Wanner, Table II.5.2) with Shampine's dense output of order 4 (Math. Comp. 46,
+#: 1986; the coefficients as in scipy's integrate/_ivp/rk.py, RK45.P).
+DOPRI5 = Pair(
+    "dopri5", c=(0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0),
+    a=((), (1 / 5,), (3 / 40, 9 / 40), (44 / 45, -56 / 15, 32 / 9),
+       (19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729),
+       (9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656), _DP5_B),
+    b=_DP5_B + (0.0,), order=5,
+    source="Dormand & Prince (1980); Shampine (1986); Hairer, Norsett & Wanner, Table II.5.2",
+    e=(71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40),
+    embedded_order=4,
+    dense=((1.0, -8048581381 / 2820520608, 8663915743 / 2820520608,
+            -12715105075 / 11282082432),
+           (0.0, 0.0, 0.0, 0.0),
+           (0.0, 131558114200 / 32700410799, -68118460800 / 10900136933,
+            87487479700 / 32700410799),
+           (0.0, -1754552775 / 470086768, 14199869525 / 1410260304,
+            -10690763975 / 1880347072),
+           (0.0, 127303824393 / 49829197408, -318862633887 / 49829197408,
+            701980252875 / 199316789632),
+           (0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844),
+           (0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423)))

@@ -1,0 +1,376 @@
+"""Error-controlled event-driven integration with an embedded pair, jit-compiled.
+
+One step at a time (Hairer, Norsett & Wanner I, §II.4): each step of the
+pair (:mod:`workbench.core.pair`) carries its own error estimate, and the
+step is accepted when, over ``tol`` times its scale
+(:mod:`workbench.core.error_scales`),
+
+* every component of (q, q') of the estimate, and
+* every event function of the regime (gaps, normal forces, stick margin,
+  slip rate), as the difference between its value at the propagated and
+  at the embedded solution,
+
+is at most 1.  The next step follows from a PI controller on the estimate
+(Hairer, Norsett & Wanner I, §IV.2, as in DOPRI5: exponents 0.7/p and
+0.4/p); steps are at most the base step ``dt`` and at least
+dt / 2^level_max, where a step is accepted whatever its estimate and
+written to ``floor_log``.
+
+Events are looked for in each accepted step (:func:`workbench.core.hybrid.locate`
+on the dense output): a sign change between the step's ends, or an event
+function negative at one of the step's stages or, for a gap turning within
+the step, at its Hermite minimum, is checked on the dense output and
+located there by Brent's method to EVENT_TIME_TOL; then one step of the
+pair from the step's start to the event gives the state there, the event
+is applied (:func:`workbench.core.hybrid.apply_event`) and the next step
+starts from it with the step size kept.  Samples are the dense output at
+the output times.  An event flood (FLOOD_EVENTS within FLOOD_WINDOW_S) hands
+STEPPED_TIME_S to Moreau-Jean time-stepping.  Every decision depends on the
+state only, so a run is deterministic.
+"""
+import math
+
+import numba as nb
+import numpy as np
+
+from .config import (EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP, STEP_REMAINDER_REL,
+                     STEPPED_TIME_S)
+from . import layout as ly
+from .constrained import rhs_regime
+from .contact import in_set, regime_of
+from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
+from .event_functions import event_values
+from .hybrid import (_copy, _copy_ev, _immediate_impact, _penetration, _stepped, _trial,
+                     apply_event, begin, flooding, locate, store)
+from .pair import dense, pair_step
+
+#: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
+#: h_new = h SAFETY err^-(1/p - 0.75 BETA) err_prev^BETA, by a factor in
+#: [FAC_MIN, FAC_MAX]; after a rejection h SAFETY err^-1/p, at least FAC_MIN.
+SAFETY = 0.9
+BETA = 0.04
+FAC_MIN = 0.2
+FAC_MAX = 10.0
+#: The PI controller's memory before the first step (Hairer's facold).
+ERR_PREV_START = 1e-4
+#: Rows of the event log the driver keeps free before a step; below this it
+#: ends the call at the next base step (LOG_FULL).
+LOG_RESERVE = 4 * (MAX_EVENTS_PER_STEP + 2)
+
+
+@nb.njit(**JIT)
+def step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, scale, ctl, t):
+    """The step's estimate over ``tol``: the new state at STAGE_NEXT, its events in EV_END.
+
+    The embedded solution y_new - err (STAGE_TRY) is evaluated in the same
+    regime, its event functions into EV_TRY (its contact forces overwrite
+    rg's).  Returns ``(status, estimate, component)``: the component of
+    (q, q') (0..17) or the event function (N_STATE + e) with the largest ratio.
+    """
+    y_new = stages[ly.STAGE_NEXT]
+    err = stages[ly.STAGE_ERR]
+    worst = 0.0
+    arg = 0
+    for i in range(ly.N_STATE):
+        r = abs(err[i]) / (tol * state_scale(i, y_new, scale))
+        if r > worst:
+            worst = r
+            arg = i
+    y_hat = stages[ly.STAGE_TRY]
+    for i in range(ly.N_AUG):
+        y_hat[i] = y_new[i] - err[i]
+    if int(rg[ly.RG_SET]) > 0:
+        status = rhs_regime(t, y_hat, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                            stages[ly.STAGE_KTRY])
+        if status != ly.OK:
+            return status, worst, arg
+    event_values(y_hat, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
+    for e in range(ly.N_EV):
+        r = abs(ev[ly.EV_END, e] - ev[ly.EV_TRY, e]) / (tol * event_scale(e, P, scale, ctl))
+        if r > worst:
+            worst = r
+            arg = ly.N_STATE + e
+    return ly.OK, worst, arg
+
+
+@nb.njit(**JIT_INLINE)
+def _next_step(h, err, err_prev, order):
+    """The PI controller's next step (s) after an accepted step of h with estimate err."""
+    e = max(err, 1e-10)
+    fac = SAFETY * e ** (-(1.0 / order - 0.75 * BETA)) * err_prev ** BETA
+    return h * min(FAC_MAX, max(FAC_MIN, fac))
+
+
+@nb.njit(**JIT)
+def _record_step(t, h, err, arg, dt, P, stages, ev, scale, ctl, floor_log, set_before, stick_before,
+                 rg, tol):
+    """Statistics of an accepted step (layout CTL_*) and, above the tolerance, its floor row."""
+    ctl[ly.CTL_STEPS] += 1.0
+    ctl[ly.CTL_INTERVALS] += 1.0
+    ctl[ly.CTL_H_MIN] = min(ctl[ly.CTL_H_MIN], h)
+    ctl[ly.CTL_H_MAX] = max(ctl[ly.CTL_H_MAX], h)
+    level = int(math.floor(math.log2(dt / h) + 1e-9)) if h < dt else 0
+    ctl[ly.CTL_LEVELS + min(max(level, 0), ly.N_CTL_LEVELS - 1)] += 1.0
+    if err > ctl[ly.CTL_ERR_MAX]:
+        ctl[ly.CTL_ERR_MAX] = err
+        ctl[ly.CTL_T_ERR_MAX] = t
+        ctl[ly.CTL_ARG_ERR_MAX] = arg
+    y = stages[ly.STAGE_NEXT]
+    q = 0.0
+    for i in range(ly.N_DOF):
+        q = max(q, abs(stages[ly.STAGE_ERR, i]) / state_scale(i, y, scale))
+    ctl[ly.CTL_Q_SSQ] += q * q
+    if err > 1.0:
+        r = int(ctl[ly.CTL_N_FLOOR])
+        if r < floor_log.shape[0]:
+            floor_log[r, ly.FL_T0] = t
+            floor_log[r, ly.FL_T1] = t + h
+            floor_log[r, ly.FL_FROM] = regime_of(set_before, stick_before)
+            floor_log[r, ly.FL_TO] = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
+            floor_log[r, ly.FL_EVENTS] = 0.0
+            floor_log[r, ly.FL_ERR] = err
+            floor_log[r, ly.FL_STEPPED] = 0.0
+        ctl[ly.CTL_N_FLOOR] += 1.0
+
+
+@nb.njit(**JIT_INLINE)
+def _event_time_error(e, h, ev, ev_err):
+    """An event's time error (s): its function's estimate ev_err[e] over its rate across the step."""
+    slope = abs(ev[ly.EV_END, e] - ev[ly.EV_START, e]) / h
+    if slope <= 0.0:
+        return 0.0
+    return ev_err[e] / slope
+
+
+#: Steps of the pair to the event (Newton's method on its time) at most.
+PAST_ITERS = 6
+#: The dense output's slope at an event is taken over this fraction of the step.
+SLOPE_FRACTION = 1e-3
+
+
+@nb.njit(**JIT)
+def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st):
+    """The state just past event e by steps of the pair from the step's start (into STAGE_HI).
+
+    ``theta`` is where the dense output of the step (its stages intact)
+    passes the event, its state in STAGE_HI and its events in EV_HI.  The
+    step of the pair to theta may end a little before the event (the two
+    approximations differ by the step's error), or past it by more than the
+    event's tolerance: Newton's method on the event's time, with the dense
+    output's slope there, moves theta until the pair's state is past it by
+    at most 2 EVENT_TIME_TOL.
+    Returns ``(status, theta)``; the events at the state in EV_HI.
+    """
+    f_past = ev[ly.EV_HI, e]
+    slope = 0.0
+    x = theta - SLOPE_FRACTION
+    if x > 0.0:
+        status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+                        cw, rg, ev)
+        if status != ly.OK:
+            return status, theta
+        slope = (f_past - ev[ly.EV_TRY, e]) / SLOPE_FRACTION
+    push = EVENT_TIME_TOL / h
+    x = theta
+    for _ in range(PAST_ITERS):
+        if x >= 1.0:
+            _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
+            _copy_ev(ev, ly.EV_END, ly.EV_HI)
+            return ly.OK, 1.0
+        status = pair_step(t, stages[ly.STAGE_CUR], x * h, P, tab, kc, free, ex, rec, mat, vec,
+                           stages, cg, cw, rg, ev, st, stages[ly.STAGE_HI])
+        if status != ly.OK:
+            return status, x
+        event_values(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
+        f = ev[ly.EV_HI, e]
+        if not slope < 0.0:
+            return ly.OK, x
+        dx = -f / slope
+        if f < 0.0 and -dx <= 2.0 * push:
+            return ly.OK, x
+        x = min(max(x + dx + push, 0.0), 1.0)
+    return ly.OK, x
+
+
+@nb.njit(**JIT)
+def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, free, ex, rec,
+                 mat, vec, stages, cg, cw, rg, ev, out_t, out_y, out_sig, log, st, ctl, scale,
+                 floor_log):
+    """Integrate n_steps base steps dt (s) from (t0, y0) with steps chosen by the error.
+
+    As :func:`workbench.core.hybrid.run_hybrid` (chunks by ``step0``; a
+    sample at every base step b, counted from the run's start, with
+    b % decim == 0, here the dense output there; LOG_FULL at a base step
+    when the log runs short), with steps of the pair in P chosen against
+    the relative tolerance ``tol`` > 0, between dt and dt / 2^level_max
+    (module docstring).  ``ctl`` (N_CTL,), ``scale`` (N_SCALE_ROWS,
+    N_STATE) and ``floor_log`` (capacity, N_FLOOR) carry the controller
+    between calls (zeros, with CTL_H_MIN = inf, before the first).
+    Returns ``(status, n_stored, n_log)``.
+    """
+    n_out = out_t.shape[0]
+    need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
+    if (y0.shape[0] != ly.N_AUG or decim < 1 or n_out < need or out_y.shape[0] < need
+            or out_sig.shape[0] < need or log.shape[0] < 2 * LOG_RESERVE
+            or not tol > 0.0 or level_max < 0 or P[ly.P_RK_DEGREE] < 1.0):
+        return ly.ERR_BAD_INPUT, 0, 0
+    y = stages[ly.STAGE_CUR]
+    for i in range(ly.N_AUG):
+        y[i] = y0[i]
+    status, stored, n_log = begin(t0, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                  rg, ev, out_t, out_y, out_sig, log, st)
+    if status != ly.OK:
+        return status, stored, n_log
+    order = P[ly.P_RK_ORDER]
+    last = int(P[ly.P_RK_STAGES]) - 1
+    floors(P, scale)
+    grow_scales(y, total_normal_force(rg), scale, ctl)
+    h_floor = dt / (1 << level_max)
+    h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
+    err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
+    t = t0
+    m_stop = step0 + n_steps                 # the base step the call ends at
+    full = False
+    b_next = (step0 // decim + 1) * decim    # the next sample's base step
+    while True:
+        t_stop = t0 + (m_stop - step0) * dt
+        if t_stop - t <= STEP_REMAINDER_REL * dt:
+            break
+        if not full and n_log + LOG_RESERVE > log.shape[0]:
+            full = True                      # end at the next base step
+            m_stop = step0 + int(math.ceil((t - t0) / dt - 1e-9))
+            continue
+        if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
+            st[ly.ST_T] = t
+            return ly.ERR_EVENT_FLOOD, stored, n_log
+        t_sample = t0 + (b_next - step0) * dt
+        if st[ly.ST_STEPPED_UNTIL] > t + STEP_REMAINDER_REL * dt:
+            # Moreau-Jean time-stepping after an event flood
+            t_next = min(st[ly.ST_STEPPED_UNTIL], t_stop)
+            if b_next <= m_stop:
+                t_next = min(t_next, t_sample)
+            status = _stepped(t, t_next - t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                              rg, ev, st)
+            if status != ly.OK:
+                st[ly.ST_T] = t
+                return status, stored, n_log
+            t = t_next
+            if b_next <= m_stop and t >= t_sample - STEP_REMAINDER_REL * dt:
+                status = store(stored, t_sample, y, P, tab, kc, free, ex, rec, mat, vec, stages,
+                               cg, cw, rg, st, out_t, out_y, out_sig)
+                if status != ly.OK:
+                    return status, stored, n_log
+                stored += 1
+                b_next += decim
+            continue
+        h_try = min(h, dt, t_stop - t)
+        set_before = int(rg[ly.RG_SET])
+        stick_before = rg[ly.RG_STICK] != 0.0
+        status = pair_step(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
+                           ev, st, stages[ly.STAGE_NEXT])
+        err = np.inf
+        arg = -1
+        force = 0.0
+        if status == ly.OK:
+            event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+            force = total_normal_force(rg)
+            status, err, arg = step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+                                          cw, rg, ev, scale, ctl, t + h_try)
+        if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
+            ctl[ly.CTL_REJECTED] += 1.0
+            ctl[ly.CTL_WORK] += 1.0
+            if arg >= ly.N_STATE:
+                ctl[ly.CTL_REJECTED_EVENTS] += 1.0
+            if status != ly.OK or not math.isfinite(err):
+                h = 0.25 * h_try
+            else:
+                h = h_try * max(FAC_MIN, SAFETY * err ** (-1.0 / order))
+            h = max(h, h_floor)
+            continue
+        if status != ly.OK:
+            st[ly.ST_T] = t
+            return status, stored, n_log
+        ctl[ly.CTL_WORK] += 1.0
+        _record_step(t, h_try, err, arg, dt, P, stages, ev, scale, ctl, floor_log, set_before,
+                     stick_before, rg, tol)
+        grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
+        ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates, kept for the log
+        for k in range(ly.N_EV):
+            ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
+        status, e, theta = locate(t, h_try, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec,
+                                  stages, cg, cw, rg, ev)
+        if status != ly.OK:
+            st[ly.ST_T] = t
+            return status, stored, n_log
+        if e >= 0:
+            te = _event_time_error(e, h_try, ev, ev_err)
+            ctl[ly.CTL_T_SSQ] += te * te
+        t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
+        if e < 0 and h_try == t_stop - t:
+            t_end = t_stop
+        # samples in (t, t_end]: the dense output of this step (or its end)
+        while b_next <= m_stop:
+            t_sample = t0 + (b_next - step0) * dt
+            if t_sample > t_end + STEP_REMAINDER_REL * dt:
+                break
+            x = (t_sample - t) / h_try
+            y_s = stages[ly.STAGE_NEXT]
+            if not (e < 0 and x >= 1.0 - 1e-12):
+                y_s = stages[ly.STAGE_HI]
+                dense(min(x, 1.0), h_try, y, P, stages, y_s)
+            status = store(stored, t_sample, y_s, P, tab, kc, free, ex, rec, mat, vec, stages,
+                           cg, cw, rg, st, out_t, out_y, out_sig)
+            if status != ly.OK:
+                return status, stored, n_log
+            stored += 1
+            b_next += decim
+        if e < 0:
+            _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+            _copy(stages, last, ly.STAGE_K1)
+            _copy_ev(ev, ly.EV_END, ly.EV_START)
+            for p in range(ly.N_POINTS):
+                ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+            t = t_end
+        else:
+            # one step of the pair from the step's start to the event
+            status, theta = _step_past(e, theta, t, h_try, P, tab, kc, free, ex, rec, mat, vec,
+                                       stages, cg, cw, rg, ev, st)
+            if status != ly.OK:
+                st[ly.ST_T] = t
+                return status, stored, n_log
+            _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
+            t = t_end if theta >= 1.0 else t + theta * h_try
+            for p in range(ly.N_POINTS):       # penetration when the event is found
+                if not in_set(int(rg[ly.RG_SET]), p):
+                    _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t, 10 + p)
+            n_step_events = 0
+            while e >= 0:
+                n_step_events += 1
+                if flooding(st, t) or n_step_events > MAX_EVENTS_PER_STEP:
+                    st[ly.ST_STEPPED_UNTIL] = t + STEPPED_TIME_S
+                    status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                                        stages[ly.STAGE_K1])
+                    if status != ly.OK:
+                        return status, stored, n_log
+                    break
+                status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                                     rg, ev, log, n_log, st)
+                if status != ly.OK:
+                    st[ly.ST_T] = t
+                    return status, stored, n_log
+                n_log += 1
+                e = _immediate_impact(ev)
+        if err <= 1.0:
+            h = _next_step(h_try, err, err_prev, order)
+            err_prev = max(err, ERR_PREV_START)
+        h = max(h, h_floor)
+        for p in range(ly.N_POINTS):
+            if not in_set(int(rg[ly.RG_SET]), p):
+                _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p], t, 20 + p)
+        st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
+        st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
+    st[ly.ST_T] = t
+    st[ly.ST_STEP] = m_stop
+    ctl[ly.CTL_H_NEXT] = h
+    ctl[ly.CTL_ERR_PREV] = err_prev
+    return (ly.LOG_FULL if full else ly.OK), stored, n_log

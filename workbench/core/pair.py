@@ -1,0 +1,119 @@
+"""An embedded explicit Runge-Kutta pair: its step, error estimate and dense output, jit-compiled.
+
+The pair's coefficients are data in the parameter array P (layout
+``P_RK_*``; :mod:`workbench.model.tableaus` writes them): Butcher's
+(c, A, b) of the propagated solution, the error weights e_i = b_i - bhat_i
+of the embedded one, and the dense output's weights as polynomials in
+theta.  The pairs taken here are FSAL (first same as last): the last stage
+is f(t + h, y_new), which is the next step's first stage (b of the last
+stage is 0 and its row of A is b).  Hairer, Norsett & Wanner, Solving
+Ordinary Differential Equations I, 2nd ed., §II.4-6.
+
+    pair_step   y_new = y + h sum_i b_i k_i, projected onto the regime's
+                constraints; the last stage f(t + h, y_new); the error
+                estimate h sum_i e_i k_i (STAGE_ERR)
+    dense       y(t + theta h) = y + h sum_i k_i sum_j d_ij theta^(j+1)
+
+A new pair of this kind is a tableau (:class:`workbench.model.tableaus.Pair`),
+not a kernel.  Arguments follow :mod:`workbench.core.constrained`.
+"""
+import math
+
+import numba as nb
+import numpy as np
+
+from .config import JIT, JIT_INLINE
+from . import layout as ly
+from .constrained import project, rhs_regime
+from .event_functions import event_values
+
+
+@nb.njit(**JIT_INLINE)
+def _stage_events_min(yt, P, free, cg, rg, ev):
+    """Lower ev[EV_MIN] to the event functions at a stage's state (its rhs_regime just ran)."""
+    event_values(yt, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
+    for e in range(ly.N_EV):
+        ev[ly.EV_MIN, e] = min(ev[ly.EV_MIN, e], ev[ly.EV_TRY, e])
+
+
+@nb.njit(**JIT)
+def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st, y_new):
+    """One step of h (s) of the pair in P from (t, y) into y_new (may not alias y).
+
+    k1 = f(t, y) must be in stages[STAGE_K1]; k_i goes to stages[i - 1], the
+    last (f(t + h, y_new), its contact forces in rg) to stages[s - 1].  y_new
+    is projected onto the regime's constraints before the last stage (the
+    projection's size goes to st).  The error estimate h sum e_i k_i goes
+    to stages[STAGE_ERR], and each event function's smallest value over the
+    inner stages' states to ev[EV_MIN] (the sign checks inside the step;
+    EV_TRY is overwritten).
+    Returns a status.
+    """
+    n = ly.N_AUG
+    s = int(P[ly.P_RK_STAGES])
+    yt = stages[ly.STAGE_TMP]
+    for e in range(ly.N_EV):
+        ev[ly.EV_MIN, e] = ev[ly.EV_START, e]
+    for i in range(n):
+        stages[0, i] = stages[ly.STAGE_K1, i]
+    for st_ in range(1, s - 1):
+        row = ly.P_RK_A + ly.MAX_RK_STAGES * st_
+        for i in range(n):
+            yt[i] = 0.0
+        for j in range(st_):
+            a = P[row + j]
+            if a != 0.0:
+                for i in range(n):
+                    yt[i] += a * stages[j, i]
+        for i in range(n):
+            yt[i] = y[i] + h * yt[i]
+        status = rhs_regime(t + P[ly.P_RK_C + st_] * h, yt, P, tab, kc, free, ex, rec, mat, vec,
+                            cg, cw, rg, stages[st_])
+        if status != ly.OK:
+            return status
+        _stage_events_min(yt, P, free, cg, rg, ev)
+    for i in range(n):
+        acc = 0.0
+        for j in range(s - 1):
+            acc += P[ly.P_RK_B + j] * stages[j, i]
+        y_new[i] = y[i] + h * acc
+        if not math.isfinite(y_new[i]):
+            return ly.ERR_NAN
+    correction, drift = project(y_new, P, free, cg, cw, rg, np.bool_(False))
+    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
+    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+    status = rhs_regime(t + h, y_new, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
+                        stages[s - 1])
+    if status != ly.OK:
+        return status
+    err = stages[ly.STAGE_ERR]
+    for i in range(n):
+        acc = 0.0
+        for j in range(s):
+            acc += P[ly.P_RK_E + j] * stages[j, i]
+        err[i] = h * acc
+    return ly.OK
+
+
+@nb.njit(**JIT)
+def dense(theta, h, y, P, stages, out):
+    """The dense output at t + theta h (0 <= theta <= 1) of the step from y just taken, into out.
+
+    The stages k_i must be those of that step (rows 0 .. s - 1).
+    """
+    s = int(P[ly.P_RK_STAGES])
+    degree = int(P[ly.P_RK_DEGREE])
+    for i in range(ly.N_AUG):
+        out[i] = y[i]
+    for j in range(s):
+        w = 0.0
+        power = theta
+        base = ly.P_RK_D + ly.MAX_DENSE_DEGREE * j
+        for d in range(degree):
+            w += P[base + d] * power
+            power *= theta
+        if w != 0.0:
+            w *= h
+            k = stages[j]
+            for i in range(ly.N_AUG):
+                out[i] += w * k[i]
