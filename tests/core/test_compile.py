@@ -34,7 +34,7 @@ def _standard_run():
 def test_a_standard_run_compiles_each_kernel_once():
     versions = _standard_run()["versions"]
     # compiled or loaded from the cache (with the kernels it links), every kernel
-    assert {"controlled.run_controlled", "hybrid.run_hybrid", "dynamics.rhs"} <= set(versions)
+    assert {"adaptive.run_adaptive", "hybrid.run_hybrid", "dynamics.rhs"} <= set(versions)
     assert {k: n for k, n in versions.items() if n > 1} == {}
 
 

@@ -1,11 +1,13 @@
 """The step method as a part you can swap (workbench/model/tableaus.py, workbench/model/methods.py).
 
-An explicit Runge-Kutta method is a tableau and one ``register`` call: the
-fixed-step and the controlled drivers, the event location and the
-controller's Richardson factor all take it from the model's parameter
-array, with no kernel of its own.  Tested with two textbook tableaus that
-are not registered by the package: Kutta's third-order method and the 3/8
-rule (Hairer, Norsett & Wanner, Solving ODE I, Table II.1.1 and II.1.2).
+An explicit Runge-Kutta method is a tableau (fixed steps) or an embedded
+pair (controlled steps) and one ``register`` call: the drivers, the event
+location, the error estimate and the dense output all take it from the
+model's parameter array, with no kernel of its own.  Tested with textbook
+methods that are not registered by the package: Kutta's third-order method
+and the 3/8 rule (Hairer, Norsett & Wanner, Solving ODE I, Table II.1.1 and
+II.1.2), and Bogacki & Shampine's 3(2) pair with its cubic Hermite dense
+output (Appl. Math. Lett. 2, 1989).
 """
 from __future__ import annotations
 
@@ -17,7 +19,7 @@ from workbench.model import drives, methods
 from workbench.model.packing import build
 from workbench.model.params import Parameters
 from workbench.model.simulate import simulate
-from workbench.model.tableaus import RK4, Tableau, write_tableau
+from workbench.model.tableaus import DOPRI5, RK4, Pair, Tableau, write_tableau
 
 KUTTA3 = Tableau("kutta3", c=(0.0, 0.5, 1.0), a=((), (0.5,), (-1.0, 2.0)),
                  b=(1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0), order=3,
@@ -26,16 +28,24 @@ RULE38 = Tableau("rule38", c=(0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0),
                  a=((), (1.0 / 3.0,), (-1.0 / 3.0, 1.0), (1.0, -1.0, 1.0)),
                  b=(1.0 / 8.0, 3.0 / 8.0, 3.0 / 8.0, 1.0 / 8.0), order=4,
                  source="Kutta (1901); Hairer, Norsett & Wanner, Table II.1.2")
+_BS3_B = (2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0, 0.0)
+#: Bogacki-Shampine 3(2), FSAL; its dense output the cubic Hermite interpolant of the step's
+#: ends and slopes, y0 + h [(3 th^2 - 2 th^3) sum b_i k_i + (th - 2 th^2 + th^3) k1 + (th^3 - th^2) k4].
+BS3 = Pair("bs3", c=(0.0, 0.5, 0.75, 1.0), a=((), (0.5,), (0.0, 0.75), _BS3_B[:3]), b=_BS3_B,
+           order=3, source="Bogacki & Shampine (1989)",
+           e=(2 / 9 - 7 / 24, 1 / 3 - 1 / 4, 4 / 9 - 1 / 3, -1 / 8), embedded_order=2,
+           dense=tuple(((1.0 if i == 0 else 0.0), 3 * b - (2.0 if i == 0 else 1.0 if i == 3 else 0.0),
+                        -2 * b + (1.0 if i in (0, 3) else 0.0)) for i, b in enumerate(_BS3_B)))
 JOINT_HELD = ("s", "v", "psi")
 
 
 @pytest.fixture
 def registered(monkeypatch):
-    """Kutta's third-order method and the 3/8 rule, fixed-step and controlled."""
-    for tableau in (KUTTA3, RULE38):
-        for name, controlled in ((tableau.name, False), (f"{tableau.name}_controlled", True)):
-            monkeypatch.delitem(methods.METHODS, name, raising=False)   # undone after the test
-            methods.register(methods.Method(name, tableau, controlled, tableau.name, 1e-4))
+    """Kutta's third-order method and the 3/8 rule (fixed steps), the BS3 pair (controlled)."""
+    for name, tableau, controlled in (("kutta3", KUTTA3, False), ("rule38", RULE38, False),
+                                      ("bs3", BS3, True)):
+        monkeypatch.delitem(methods.METHODS, name, raising=False)   # undone after the test
+        methods.register(methods.Method(name, tableau, controlled, tableau.name, 1e-4))
 
 
 def tip_after(method, dt, duration=0.02):
@@ -57,15 +67,29 @@ def test_a_registered_tableau_runs_at_its_own_order(registered, tableau):
     assert abs(slope - tableau.order) < 0.3, (slope, errors)
 
 
-def test_the_controller_takes_the_order_of_the_tableau(registered):
-    """Step doubling over the same 0.1 ms control intervals: the estimate of the pair
-    (dt, dt/2) over that of (dt/2, dt/4) is 2^3 for Kutta's third-order method, whose
-    Richardson factor the controller takes from the tableau (2^3 - 1)."""
-    est = [simulate(Parameters(), drives.sine(100.0, 20.0), 0.05, dt=dt, tol=1e-3, level_max=1,
-                    method="kutta3_controlled", fixed=JOINT_HELD, initial="paper",
-                    output_hz=10000).control["error_over_tol_max"]
+@pytest.mark.parametrize("name, local_order", [("bs3", 3), ("dopri5", 5)])
+def test_the_controller_takes_the_estimate_of_the_pair(registered, name, local_order):
+    """Steps held at dt (level_max 0: every step is the smallest), smooth motion: the
+    embedded estimate is the local error of the pair's lower order, O(dt^(phat + 1)), so
+    halving dt divides it by 2^3 for BS3 (2) and 2^5 for Dormand-Prince (4)."""
+    est = [simulate(Parameters(), drives.sine(100.0, 20.0), 0.02, dt=dt, tol=1e-3, level_max=0,
+                    method=name, fixed=JOINT_HELD, initial="paper",
+                    output_hz=1.0 / dt).control["error_over_tol_max"]
            for dt in (1e-4, 5e-5)]
-    assert 7.0 < est[0] / est[1] < 9.0, est
+    ratio = est[0] / est[1]
+    assert 0.75 * 2 ** local_order < ratio < 1.3 * 2 ** local_order, est
+
+
+def test_a_pair_that_misses_its_conditions_is_refused():
+    with pytest.raises(ValueError, match="misses an order-2 condition"):
+        Pair("bad", BS3.c, BS3.a, BS3.b, order=3, source="", e=(0.1, 0.0, 0.0, -0.1),
+             embedded_order=2, dense=BS3.dense)
+    with pytest.raises(ValueError, match="must equal b at theta = 1"):
+        Pair("bad", BS3.c, BS3.a, BS3.b, order=3, source="", e=BS3.e, embedded_order=2,
+             dense=((1.0, 0.0, 0.0),) + BS3.dense[1:])
+    with pytest.raises(ValueError, match="a controlled method steps with an embedded pair"):
+        methods.Method("bad", RK4, True, "", 1e-4)
+    assert DOPRI5.order == 5 and DOPRI5.embedded_order == 4 and DOPRI5.degree == 4
 
 
 def test_the_tableau_is_written_where_the_kernels_read_it():
@@ -74,10 +98,13 @@ def test_the_tableau_is_written_where_the_kernels_read_it():
     write_tableau(P, KUTTA3)
     m = ly.MAX_RK_STAGES
     assert P[ly.P_RK_STAGES] == 3 and P[ly.P_RK_ORDER] == 3
-    assert list(P[ly.P_RK_C:ly.P_RK_C + m]) == [0.0, 0.5, 1.0, 0.0, 0.0, 0.0]
+    assert list(P[ly.P_RK_C:ly.P_RK_C + m]) == [0.0, 0.5, 1.0] + [0.0] * (m - 3)
     assert list(P[ly.P_RK_B:ly.P_RK_B + 3]) == list(KUTTA3.b)
-    np.testing.assert_array_equal(P[ly.P_RK_A:].reshape(m, m)[:3, :3], KUTTA3.matrix())
-    assert not P[ly.P_RK_A:].reshape(m, m)[3:].any()
+    np.testing.assert_array_equal(P[ly.P_RK_A:ly.P_RK_E].reshape(m, m)[:3, :3], KUTTA3.matrix())
+    assert not P[ly.P_RK_A:ly.P_RK_E].reshape(m, m)[3:].any()
+    assert not P[ly.P_RK_E:].any()                  # no error weights, no dense output
+    write_tableau(P, DOPRI5)
+    assert P[ly.P_RK_DEGREE] == 4 and list(P[ly.P_RK_E:ly.P_RK_E + m]) == list(DOPRI5.e)
 
 
 def test_a_tableau_that_misses_its_order_is_refused():
@@ -85,6 +112,6 @@ def test_a_tableau_that_misses_its_order_is_refused():
         Tableau("bad", KUTTA3.c, KUTTA3.a, KUTTA3.b, order=4, source="")
     with pytest.raises(ValueError, match="c_i must equal"):
         Tableau("bad", (0.0, 0.4, 1.0), KUTTA3.a, KUTTA3.b, order=1, source="")
-    with pytest.raises(ValueError, match="stages; the kernels take 1 to 6"):
-        Tableau("bad", (0.0,) * 7, tuple((0.0,) * i for i in range(7)), (1.0,) + (0.0,) * 6,
+    with pytest.raises(ValueError, match="stages; the kernels take 1 to 7"):
+        Tableau("bad", (0.0,) * 8, tuple((0.0,) * i for i in range(8)), (1.0,) + (0.0,) * 7,
                 order=1, source="")

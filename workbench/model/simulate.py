@@ -410,12 +410,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
     excitation is evaluated at those times (e.g. to continue from a state
     of an earlier run, given as ``initial`` with its ``regime``).
-    ``method`` (:mod:`workbench.model.methods`): "controlled" (the default)
+    ``method`` (:mod:`workbench.model.methods`): "dopri5" (the default)
     chooses the steps by an error estimate against the relative tolerance
-    ``tol`` (default DEFAULT_TOL), down to dt / 2^level_max; "rk4" takes
+    ``tol`` (default DEFAULT_TOL), from dt down to dt / 2^level_max; "rk4" takes
     fixed RK4 steps of dt, and is the default when ``dt`` is given without
     ``tol``.  ``dt`` (s) is the fixed step, or the controlled method's
-    coarsest; by default :func:`default_dt`.
+    largest (and its output lattice); by default :func:`default_dt`.
     ``output_hz`` is the sample rate of the signals; 1 / (output_hz dt)
     must be a whole number.  By default limits.DEFAULT_OUTPUT_HZ, or for a hammer
     PULSE_SAMPLES samples a pulse (the next rate dividing 1 / dt).  ``fixed`` holds coordinates (tests, locked

@@ -16,11 +16,11 @@ import time
 
 #: name -> Python code exercising the entry points of that group.
 GROUPS = {
-    "event loop (run_controlled, run_hybrid)": """
+    "event loop (run_adaptive, run_hybrid)": """
         from workbench.model.drives import sine
         from workbench.model.params import Parameters
         from workbench.model.simulate import simulate
-        for method in ("controlled", "rk4"):
+        for method in ("dopri5", "rk4"):
             simulate(Parameters(), sine(200.0, 20.0), duration=0.002, initial="paper",
                      method=method)
     """,

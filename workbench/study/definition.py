@@ -6,9 +6,9 @@
     window_s = 2.0                   # steady-state window at the end of each point (s)
     sweep = "independent"            # or "up", "down", "up-down" (stepped frequency sweeps)
     tol = 1e-4                       # optional tolerance of the controlled method (the default)
-    method = "controlled"            # optional: "controlled", or "rk4" (fixed steps of dt)
+    method = "dopri5"                # optional: "dopri5" (controlled), or "rk4" (fixed steps of dt)
     dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
-                                     # controlled method's coarsest; default: simulate.default_dt
+                                     # controlled method's largest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
     check_accuracy = true            # optional: each point also run at a tenth of tol and half
                                      # the step (a quarter of a fixed dt), its error measured
@@ -111,7 +111,7 @@ class Study:
     axes: dict
     save_series: tuple = ()
     source: str = ""
-    method: str = "controlled"
+    method: str = "dopri5"
     tol: float | None = None
     tip_limit_cm: float | None = None
     check_accuracy: bool = False
@@ -204,7 +204,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     check_accuracy = head.get("check_accuracy", False)
     if not isinstance(check_accuracy, bool):
         raise StudyError(f"[study] check_accuracy = {_short(check_accuracy)} must be true or false")
-    if check_accuracy and method == "controlled":
+    if check_accuracy and tol is not None:
         from ..model.accuracy import companion_settings
         companion_settings(True, tol, 0.0, name="[study] tol")
     initial = head.get("initial", "static")
