@@ -142,8 +142,10 @@ def _event_time_error(e, h, ev, ev_err):
     return ev_err[e] / slope
 
 
-#: Steps of the pair to the event (Newton's method on its time) at most.
-PAST_ITERS = 6
+#: Steps of the pair to the event (Newton's method on its time) at most ...
+PAST_ITERS = 8
+#: ... to land past the event by less than this fraction of its error scale.
+PAST_REL = 1e-6
 #: The dense output's slope at an event is taken over this fraction of the step.
 SLOPE_FRACTION = 1e-3
 
@@ -154,23 +156,22 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
 
     ``theta`` is where the dense output of the step (its stages intact)
     passes the event, its state in STAGE_HI and its events in EV_HI.  The
-    step of the pair to theta may end a little before the event (the two
-    approximations differ by the step's error), or past it by more than the
-    event's tolerance: Newton's method on the event's time, with the dense
-    output's slope there, moves theta until the pair's state is past it by
-    at most 2 EVENT_TIME_TOL.
+    step of the pair to theta may end before the event or past it by more
+    than the event's own thresholds (the two approximations differ by the
+    step's error; a slip rate passing zero at 3e5 cm/s^2 changes by 3e-6 cm/s
+    in EVENT_TIME_TOL): Newton's method on the event's time, with the dense
+    output's slope there, moves theta until the pair's state is past the
+    event by less than PAST_REL of its error scale (ev[EV_NOISE]).
     Returns ``(status, theta)``; the events at the state in EV_HI.
     """
     f_past = ev[ly.EV_HI, e]
-    slope = 0.0
-    x = theta - SLOPE_FRACTION
-    if x > 0.0:
-        status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg,
-                        cw, rg, ev)
-        if status != ly.OK:
-            return status, theta
-        slope = (f_past - ev[ly.EV_TRY, e]) / SLOPE_FRACTION
-    push = EVENT_TIME_TOL / h
+    band = max(PAST_REL * ev[ly.EV_NOISE, e], 1e-300)
+    x = theta - SLOPE_FRACTION if theta > SLOPE_FRACTION else theta + SLOPE_FRACTION
+    status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
+                    rg, ev)
+    if status != ly.OK:
+        return status, theta
+    slope = (ev[ly.EV_TRY, e] - f_past) / (x - theta)
     x = theta
     for _ in range(PAST_ITERS):
         if x >= 1.0:
@@ -183,12 +184,9 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
             return status, x
         event_values(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
         f = ev[ly.EV_HI, e]
-        if not slope < 0.0:
+        if (-band < f < 0.0) or not slope < 0.0:
             return ly.OK, x
-        dx = -f / slope
-        if f < 0.0 and -dx <= 2.0 * push:
-            return ly.OK, x
-        x = min(max(x + dx + push, 0.0), 1.0)
+        x = min(max(x + (-0.5 * band - f) / slope, 0.0), 1.0)
     return ly.OK, x
 
 
@@ -225,6 +223,8 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
     last = int(P[ly.P_RK_STAGES]) - 1
     floors(P, scale)
     grow_scales(y, total_normal_force(rg), scale, ctl)
+    for e in range(ly.N_EV):
+        ev[ly.EV_NOISE, e] = tol * event_scale(e, P, scale, ctl)
     h_floor = dt / (1 << level_max)
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
     err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
@@ -294,6 +294,8 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
         _record_step(t, h_try, err, arg, dt, P, stages, ev, scale, ctl, floor_log, set_before,
                      stick_before, rg, tol)
         grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
+        for k in range(ly.N_EV):
+            ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
         ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates, kept for the log
         for k in range(ly.N_EV):
             ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])

@@ -265,7 +265,8 @@ def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     step.  The dense output is evaluated at the SCAN_POINTS before ``before``
     and, for a turning gap, where its cubic Hermite interpolant of the ends
     is smallest.  Returns ``(status, theta)``: the first theta whose state
-    is past the change (in STAGE_HI, its events in EV_HI), or -1.
+    is past the change by more than the function's error (ev[EV_NOISE]; in
+    STAGE_HI, its events in EV_HI), or -1.
     """
     xs = SCAN_POINTS
     x_min = -1.0
@@ -282,7 +283,7 @@ def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
                         cw, rg, ev)
         if status != ly.OK:
             return status, -1.0
-        if ev[ly.EV_TRY, e] < 0.0:
+        if ev[ly.EV_TRY, e] < -ev[ly.EV_NOISE, e]:
             _copy(stages, ly.STAGE_TRY, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_TRY, ly.EV_HI)
             return ly.OK, x
@@ -315,7 +316,7 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
         elif on_dense:
             turning = (e < ly.EV_GAP + ly.N_POINTS and ev[ly.EV_RATE_START, e] < 0.0
                        and ev[ly.EV_RATE_END, e] > 0.0 and f0 < 1.0)
-            if turning or ev[ly.EV_MIN, e] < 0.0:
+            if turning or ev[ly.EV_MIN, e] < -ev[ly.EV_NOISE, e]:
                 status, x = _scan(e, t, h, best_theta, P, tab, kc, free, ex, rec, mat, vec, stages,
                                   cg, cw, rg, ev)
                 if status != ly.OK:
@@ -477,7 +478,10 @@ def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, e
         kind = ly.KIND_STICK_SLIP
         point = ly.SET_FIRST[set_index] + 1
     else:
+        # the slip rate is zero at the event: the state just past it (its time located
+        # to EVENT_TIME_TOL, where the rate may change by ~1e-5 cm/s) is put at rest
         rg[ly.RG_STICK] = 1.0
+        project(y, P, free, cg, cw, rg, np.bool_(False))
         kind = ly.KIND_SLIP_STICK
         point = ly.SET_FIRST[set_index] + 1
     status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, k1, st,

@@ -252,9 +252,11 @@ N_CW_COLS = N_LAW_COLS
 # + to - when its event happens; functions not watched in a regime are +1.
 # Rows: values at the step's start, end, a trial point, the earliest point
 # found past an event (HI); gap rates at the start, end and trial point;
-# (EV_MIN) the smallest value of each force event over a step's stages.
-EV_START, EV_END, EV_TRY, EV_HI, EV_RATE_START, EV_RATE_END, EV_RATE_TRY, EV_MIN = range(8)
-N_EV_ROWS = 8
+# (EV_MIN) the smallest value of each event function over a step's stages;
+# (EV_NOISE) the error each function may carry (a dip inside a step counts
+# only below minus it; zeros for the fixed-step method).
+EV_START, EV_END, EV_TRY, EV_HI, EV_RATE_START, EV_RATE_END, EV_RATE_TRY, EV_MIN, EV_NOISE = range(9)
+N_EV_ROWS = 9
 EV_GAP = 0                   # EV_GAP + k: open gap g_k (impact); rates hold g_k'
 EV_LAMBDA = EV_GAP + N_POINTS  # EV_LAMBDA + k: lambda_n of active point k (separation)
 EV_STICK = EV_LAMBDA + N_POINTS  # mu_s sum lambda_n - |lambda_t| (stick -> slip)
