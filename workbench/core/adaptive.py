@@ -142,10 +142,8 @@ def _event_time_error(e, h, ev, ev_err):
     return ev_err[e] / slope
 
 
-#: Steps of the pair to the event (Newton's method on its time) at most ...
-PAST_ITERS = 8
-#: ... to land past the event by less than this fraction of its error scale.
-PAST_REL = 1e-6
+#: Steps of the pair to the event (Newton's method on its time) at most.
+PAST_ITERS = 40
 #: The dense output's slope at an event is taken over this fraction of the step.
 SLOPE_FRACTION = 1e-3
 
@@ -158,20 +156,24 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
     passes the event, its state in STAGE_HI and its events in EV_HI.  The
     step of the pair to theta may end before the event or past it by more
     than the event's own thresholds (the two approximations differ by the
-    step's error; a slip rate passing zero at 3e5 cm/s^2 changes by 3e-6 cm/s
-    in EVENT_TIME_TOL): Newton's method on the event's time, with the dense
-    output's slope there, moves theta until the pair's state is past the
-    event by less than PAST_REL of its error scale (ev[EV_NOISE]).
-    Returns ``(status, theta)``; the events at the state in EV_HI.
+    step's error): Newton's method on the event's time, with the dense
+    output's slope there, safeguarded by bisection of the bracket the
+    pair's steps have found (an event function may have a kink there: a
+    double contact's stick margin), moves theta until the pair's state is
+    past the event by about what the function changes in EVENT_TIME_TOL, or
+    the bracket is EVENT_TIME_TOL wide.  Returns ``(status, theta)``; the
+    events at the state in EV_HI.
     """
     f_past = ev[ly.EV_HI, e]
-    band = max(PAST_REL * ev[ly.EV_NOISE, e], 1e-300)
     x = theta - SLOPE_FRACTION if theta > SLOPE_FRACTION else theta + SLOPE_FRACTION
     status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
                     rg, ev)
     if status != ly.OK:
         return status, theta
     slope = (ev[ly.EV_TRY, e] - f_past) / (x - theta)
+    push = EVENT_TIME_TOL / h
+    depth = max(-slope * push, 1e-300)
+    lo, hi = 0.0, 2.0            # exact f >= 0 at lo (the step's start), < 0 at hi (if <= 1)
     x = theta
     for _ in range(PAST_ITERS):
         if x >= 1.0:
@@ -184,9 +186,19 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
             return status, x
         event_values(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
         f = ev[ly.EV_HI, e]
-        if (-band < f < 0.0) or not slope < 0.0:
-            return ly.OK, x
-        x = min(max(x + (-0.5 * band - f) / slope, 0.0), 1.0)
+        if f < 0.0:
+            hi = x
+            if f > -2.0 * depth or hi - lo <= push:
+                return ly.OK, x
+        else:
+            lo = x
+        nxt = x + (-depth - f) / slope if slope < 0.0 else -1.0
+        if hi <= 1.0:
+            if not lo < nxt < hi:
+                nxt = 0.5 * (lo + hi)
+        elif not nxt > lo:
+            nxt = lo + 2.0 * (lo - theta) + push     # no bracket yet: step further out
+        x = min(nxt, 1.0)
     return ly.OK, x
 
 
