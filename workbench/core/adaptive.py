@@ -46,11 +46,14 @@ from .pair import dense, pair_step
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
 #: h_new = h SAFETY err^-(1/p - 0.75 BETA) err_prev^BETA, by a factor in
-#: [FAC_MIN, FAC_MAX]; after a rejection h SAFETY err^-1/p, at least FAC_MIN.
+#: [FAC_MIN, FAC_MAX], and not above h right after a rejection; after a
+#: rejection h SAFETY err^-1/p, at least FAC_MIN.
 SAFETY = 0.9
 BETA = 0.04
 FAC_MIN = 0.2
 FAC_MAX = 10.0
+#: Steps are at most this many base steps dt (the step at which RK4 is stable).
+MAX_STEP_FACTOR = 1.0
 #: The PI controller's memory before the first step (Hairer's facold).
 ERR_PREV_START = 1e-4
 #: Rows of the event log the driver keeps free before a step; below this it
@@ -203,11 +206,15 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
 
 
 @nb.njit(**JIT)
-def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, free, ex, rec,
-                 mat, vec, stages, cg, cw, rg, ev, out_t, out_y, out_sig, log, st, ctl, scale,
-                 floor_log):
+def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, work, out, log, st,
+                 control):
     """Integrate n_steps base steps dt (s) from (t0, y0) with steps chosen by the error.
 
+    The arrays come in named groups: ``model`` (P, tab, kc, free) and
+    ``work`` (rec, mat, vec, stages, cg, cw, rg, ev), as
+    :mod:`workbench.model.packing` builds them; ``out`` (out_t, out_y,
+    out_sig), the samples; ``control`` (ctl, scale, floor_log), the
+    controller's state.
     As :func:`workbench.core.hybrid.run_hybrid` (chunks by ``step0``; a
     sample at every base step b, counted from the run's start, with
     b % decim == 0, here the dense output there; LOG_FULL at a base step
@@ -218,6 +225,10 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
     between calls (zeros, with CTL_H_MIN = inf, before the first).
     Returns ``(status, n_stored, n_log)``.
     """
+    P, tab, kc, free = model
+    rec, mat, vec, stages, cg, cw, rg, ev = work
+    out_t, out_y, out_sig = out
+    ctl, scale, floor_log = control
     n_out = out_t.shape[0]
     need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
     if (y0.shape[0] != ly.N_AUG or decim < 1 or n_out < need or out_y.shape[0] < need
@@ -241,6 +252,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
     err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
     t = t0
+    rejected = False                         # the last step tried was rejected
     m_stop = step0 + n_steps                 # the base step the call ends at
     full = False
     b_next = (step0 // decim + 1) * decim    # the next sample's base step
@@ -275,7 +287,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
                 stored += 1
                 b_next += decim
             continue
-        h_try = min(h, dt, t_stop - t)
+        h_try = min(h, MAX_STEP_FACTOR * dt, t_stop - t)
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
         status = pair_step(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
@@ -298,6 +310,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
             else:
                 h = h_try * max(FAC_MIN, SAFETY * err ** (-1.0 / order))
             h = max(h, h_floor)
+            rejected = True
             continue
         if status != ly.OK:
             st[ly.ST_T] = t
@@ -376,7 +389,10 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, P, tab, kc, 
                 e = _immediate_impact(ev)
         if err <= 1.0:
             h = _next_step(h_try, err, err_prev, order)
+            if rejected:                     # no growth right after a rejection
+                h = min(h, h_try)
             err_prev = max(err, ERR_PREV_START)
+        rejected = False
         h = max(h, h_floor)
         for p in range(ly.N_POINTS):
             if not in_set(int(rg[ly.RG_SET]), p):

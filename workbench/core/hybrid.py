@@ -680,10 +680,13 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
 
 
 @nb.njit(**JIT)
-def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat, vec, stages,
-               cg, cw, rg, ev, out_t, out_y, out_sig, log, st):
+def run_hybrid(y0, t0, dt, n_steps, step0, decim, model, ex, work, out, log, st):
     """Integrate n_steps fixed steps of dt (s) from (t0, y0) with contact events.
 
+    The arrays come in named groups: ``model`` (P, tab, kc, free) and
+    ``work`` (rec, mat, vec, stages, cg, cw, rg, ev), as
+    :mod:`workbench.model.packing` builds them; ``out`` (out_t, out_y,
+    out_sig), the samples.
     y0 (N_AUG,) is the augmented state; rg holds the starting regime and,
     on return, the final one; STAGE_CUR holds the final state.  ``step0``
     counts the steps done by earlier calls (a run in chunks): a sample is
@@ -696,6 +699,9 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, P, tab, kc, free, ex, rec, mat
 
     Returns ``(status, n_stored, n_log)``.
     """
+    P, tab, kc, free = model
+    rec, mat, vec, stages, cg, cw, rg, ev = work
+    out_t, out_y, out_sig = out
     n_out = out_t.shape[0]
     need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
     if (y0.shape[0] != ly.N_AUG or decim < 1 or n_out < need or out_y.shape[0] < need

@@ -475,10 +475,11 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         from tqdm import tqdm
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
     first_use = _first_use[0].take() if _first_use else 0.0     # the kernels before the loop's
-    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, *model, ex, *work,
-                                        np.empty(1), np.empty((1, ly.N_STATE)),
-                                        np.empty((1, ly.N_SIG)), np.empty((1, ly.N_LOG)), st,
-                                        *controller))
+    control = (controller,) if controller else ()
+    compile_s = compile_kernel(kernel, (y, float(t0), dt, 1, 0, k, *settings, model, ex, work,
+                                        (np.empty(1), np.empty((1, ly.N_STATE)),
+                                         np.empty((1, ly.N_SIG))), np.empty((1, ly.N_LOG)), st,
+                                        *control))
     if _first_use:
         _first_use[0].take()                                # in compile_kernel's seconds
     compile_s += first_use + _compile_unreported.pop(_kernel_name(kernel), 0.0)
@@ -492,8 +493,8 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         out_y = np.empty((n_out, ly.N_STATE))
         out_sig = np.empty((n_out, ly.N_SIG))
         log = np.empty((_LOG_ROWS, ly.N_LOG))
-        status, stored, n_log = kernel(y, t0 + done * dt, dt, n, done, k, *settings, *model, ex,
-                                       *work, out_t, out_y, out_sig, log, st, *controller)
+        status, stored, n_log = kernel(y, t0 + done * dt, dt, n, done, k, *settings, model, ex,
+                                       work, (out_t, out_y, out_sig), log, st, *control)
         keep = slice((-n_internal) % m, stored, m)
         parts_t.append(out_t[keep])
         parts_y.append(out_y[keep])
