@@ -27,9 +27,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from workbench.core import layout as ly
-from workbench.core.config import EVENT_TIME_TOL, GAP_TOL, MAX_EVENTS_PER_STEP, STEPPED_STEPS
+from workbench.core.config import (EVENT_TIME_TOL, FLOOD_EVENTS, FLOOD_WINDOW_S, GAP_TOL,
+                                   STEPPED_TIME_S)
 from workbench.core.constrained import rhs_regime
-from workbench.core.hybrid import _immediate_impact, _stepped, apply_event, event_values
+from workbench.core.event_functions import event_values
+from workbench.core.hybrid import _immediate_impact, _stepped, apply_event
 from workbench.core.sensors import fill_signals
 from workbench.core.transitions import choose_regime
 from workbench.model import packing as mdl
@@ -53,7 +55,7 @@ class CompiledLSODA:
         self.work = mdl.make_work()
         self.ex = ex
         self.method = method
-        # the accumulation rule counts in kernel steps (docs/model.md §7): the kernel's step
+        # the Moreau-Jean episode after a flood steps at the kernel's base step
         self.dt_rule = default_dt(params, ex)
         self.y = np.zeros(ly.N_AUG)
         self.ydot = np.zeros(ly.N_AUG)
@@ -108,8 +110,8 @@ class CompiledLSODA:
         cur[:] = 0.0
         cur[:ly.N_STATE] = y
         while e >= 0:
-            status = apply_event(e, t, self.dt_rule, *self.model, self.ex, w.rec, w.mat, w.vec,
-                                 w.stages, w.cg, w.cw, w.rg, w.ev, self.log, 0, self.st)
+            status = apply_event(e, t, *self.model, self.ex, w.rec, w.mat, w.vec, w.stages, w.cg,
+                                 w.cw, w.rg, w.ev, self.log, 0, self.st)
             if status != ly.OK:
                 raise RuntimeError(f"apply_event status {status} at t = {t}")
             e = _immediate_impact(w.ev)
@@ -117,16 +119,15 @@ class CompiledLSODA:
         return cur[:ly.N_STATE].copy()
 
     def _stepped_episode(self, t, t1, y, sample_times, times, tips, shares):
-        """The kernel's answer to an event flood: Moreau-Jean steps of the kernel's step.
-
-        STEPPED_STEPS + 1 steps (the kernel's rest of the step and STEPPED_STEPS
-        more); the tip at the samples inside is interpolated linearly.
+        """The kernel's answer to an event flood: Moreau-Jean steps of the kernel's base step
+        over STEPPED_TIME_S; the tip at the samples inside is interpolated linearly.
         Returns the time and state after it.
         """
         w = self.work
         cur = w.stages[ly.STAGE_CUR]
-        for _ in range(STEPPED_STEPS + 1):
-            h = min(self.dt_rule, t1 - t)
+        t_stop = min(t + STEPPED_TIME_S, t1)
+        while True:
+            h = min(self.dt_rule, t_stop - t)
             if h <= 1e-12:
                 break
             reg = regime_of(int(w.rg[ly.RG_SET]), w.rg[ly.RG_STICK] != 0.0)
@@ -151,8 +152,8 @@ class CompiledLSODA:
         """Integrate from (t0, y0) in ``regime`` to t1; the tip height at sample_times.
 
         Returns (sample times, tip heights (cm), contact-time shares by
-        contact code, events).  More than MAX_EVENTS_PER_STEP events within
-        one kernel step are handed to the kernel's Moreau-Jean steps, as the
+        contact code, events).  More than FLOOD_EVENTS events within
+        FLOOD_WINDOW_S are handed to the kernel's Moreau-Jean steps, as the
         kernel does.
         """
         w = self.work
@@ -162,6 +163,7 @@ class CompiledLSODA:
         w.rg[ly.RG_SIGN] = 1.0
         self.st[:] = 0.0
         self.st[ly.ST_T_IMPACT] = -1e300
+        self.st[ly.ST_FLOOD_T0] = -1e300
         self.y[:] = 0.0
         self.y[:ly.N_STATE] = y0
         status = choose_regime(t0, self.y, *self.model, self.ex, w.rec, w.mat, w.vec, w.stages,
@@ -201,8 +203,8 @@ class CompiledLSODA:
             y = self._transition(e, t_past, y_past)
             t = t_past
             n_events += 1
-            recent = [r for r in recent if t - r < self.dt_rule] + [t]
-            if len(recent) > MAX_EVENTS_PER_STEP:
+            recent = [r for r in recent if t - r <= FLOOD_WINDOW_S] + [t]
+            if len(recent) > FLOOD_EVENTS:
                 t, y = self._stepped_episode(t, t1, y, sample_times, times, tips, shares)
                 recent = []
         total = sum(shares.values())

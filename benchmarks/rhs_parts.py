@@ -20,7 +20,7 @@ from workbench.model import packing as mdl
 from workbench.core import layout as ly
 from workbench.core.constrained import project, rhs_regime
 from workbench.core.dynamics import add_applied_forces, assemble_inertia, factor_free, rhs
-from workbench.core.hybrid import event_values
+from workbench.core.event_functions import event_values
 from workbench.core.integrate import rk_step
 from workbench.model.drives import sine
 from workbench.model.params import Parameters

@@ -49,11 +49,11 @@ def test_event_times_agree_with_the_reference(both):
 
 
 def test_the_default_tolerance_takes_the_references_events(both):
-    """The controlled method at its default tolerance, not told the step: every event of the
+    """The default method at its default tolerance, not told the step: every event of the
     reference, in order, within 1e-6 s."""
     ref_log = both[1]
     run = simulate(Parameters(), None, HORIZON, initial="paper")
-    assert run.ok and run.method == "controlled" and run.control["floor_count"] == 0
+    assert run.ok and run.method == "dopri5" and run.control["floor_count"] == 0
     ev = run.events[run.events.kind != "start"]
     assert len(ev) == len(ref_log)
     for k, r in zip(ev.itertuples(), ref_log):

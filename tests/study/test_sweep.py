@@ -70,7 +70,7 @@ def test_small_grid_end_to_end(small_run):
     on_disk = pd.read_parquet(root / "res1" / "small" / "points.parquet")
     pd.testing.assert_frame_equal(on_disk, table)
     # each point keeps the integrator's account: the default method met its tolerance
-    assert (table.method == "controlled").all() and (table.tol == study.tol).all()
+    assert (table.method == "dopri5").all() and (table.tol == study.tol).all()
     assert (table.error_over_tol_max <= 1.0).all() and (table.floor_count == 0).all()
     assert (table.steps_all >= table.steps).all() and (table.h_min <= table.h_max).all()
     series = sorted(p.name for p in (root / "res1" / "small" / "series").iterdir())
@@ -142,7 +142,7 @@ def test_a_failing_point_is_recorded_and_the_sweep_goes_on(small_run, tmp_path, 
 def test_an_unstable_point_is_recorded_as_failed(tmp_path, monkeypatch):
     """A run that ends with a failure status (here: fixed RK4 steps far beyond its stability,
     which a study cannot ask for, forced through the API) is a recorded point, with its
-    figures.  (The controlled method refines such a step until it is stable.)"""
+    figures.  (The controlled method shrinks such a step until it is stable.)"""
     text = SMALL.replace("gap_mm = [0.508, 1.016]", "gap_mm = [1.016]").replace(
         "freq_hz = [20.0, 30.0]", "freq_hz = [20.0]")
     with pytest.raises(ParameterError, match="stability limit"):
