@@ -275,10 +275,18 @@ def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
         m1 = h * ev[ly.EV_RATE_END, e]
         if m0 < 0.0 and m1 > 0.0:
             x_min, _ = _hermite_min(ev[ly.EV_START, e], ev[ly.EV_END, e], m0, m1)
+    is_gap = e < ly.EV_GAP + ly.N_POINTS
     for k in range(len(xs) + 1):
         x = x_min if k == 0 else xs[k - 1]
         if not (0.0 < x < before):
             continue
+        if is_gap:
+            # a gap is a function of q alone: the geometry of the dense state first
+            dense(x, h, stages[ly.STAGE_CUR], P, stages, stages[ly.STAGE_TRY])
+            fill_geometry(stages[ly.STAGE_TRY], P, cg)
+            p = e - ly.EV_GAP
+            if not cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] < -ev[ly.EV_NOISE, e]:
+                continue
         status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg,
                         cw, rg, ev)
         if status != ly.OK:
