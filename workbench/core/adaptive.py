@@ -33,15 +33,15 @@ import math
 import numba as nb
 import numpy as np
 
-from .config import (EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP, STEP_REMAINDER_REL,
+from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP, STEP_REMAINDER_REL,
                      STEPPED_TIME_S)
 from . import layout as ly
 from .constrained import rhs_regime
 from .contact import in_set, regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
 from .event_functions import event_values
-from .hybrid import (_copy, _copy_ev, _immediate_impact, _penetration, _stepped, _trial,
-                     apply_event, begin, flooding, locate, store)
+from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _penetration, _stepped,
+                     _trial, apply_event, begin, flooding, locate, store)
 from .pair import dense, pair_step
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
@@ -105,8 +105,7 @@ def _next_step(h, err, err_prev, order):
 
 
 @nb.njit(**JIT)
-def _record_step(t, h, err, arg, dt, P, stages, ev, scale, ctl, floor_log, set_before, stick_before,
-                 rg, tol):
+def _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, set_before, stick_before):
     """Statistics of an accepted step (layout CTL_*) and, above the tolerance, its floor row."""
     ctl[ly.CTL_STEPS] += 1.0
     ctl[ly.CTL_INTERVALS] += 1.0
@@ -137,10 +136,11 @@ def _record_step(t, h, err, arg, dt, P, stages, ev, scale, ctl, floor_log, set_b
 
 
 @nb.njit(**JIT_INLINE)
-def _event_time_error(e, h, ev, ev_err):
-    """An event's time error (s): its function's estimate ev_err[e] over its rate across the step."""
-    slope = abs(ev[ly.EV_END, e] - ev[ly.EV_START, e]) / h
-    if slope <= 0.0:
+def _event_time_error(e, span, ev, ev_err):
+    """An event's time error (s): its function's estimate ev_err[e] over its mean rate from the
+    step's start to the event, ``span`` (s) later (its state just past it in EV_HI)."""
+    slope = abs(ev[ly.EV_START, e] - ev[ly.EV_HI, e]) / span
+    if not slope > 0.0:
         return 0.0
     return ev_err[e] / slope
 
@@ -203,6 +203,32 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
             nxt = lo + 2.0 * (lo - theta) + push     # no bracket yet: step further out
         x = min(nxt, 1.0)
     return ly.OK, x
+
+
+@nb.njit(**JIT)
+def _earlier_on_steps(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+    """Another event passed on the way to event e's state (STAGE_HI, its events in EV_HI)?
+
+    The pair's steps may reach e later than its dense output did, and pass
+    an event the dense output had not reached by then: that event, located
+    by Brent's method on the pair's steps from the step's start, comes
+    first.  Returns ``(status, event, theta)``, the state past it in STAGE_HI.
+    """
+    for _ in range(ly.N_EV):
+        earlier = -1
+        for k in range(ly.N_EV):
+            if k != e and ev[ly.EV_START, k] >= 0.0 and ev[ly.EV_HI, k] < 0.0:
+                earlier = k
+                break
+        if earlier < 0:
+            break
+        status, theta = _bracket(earlier, ev[ly.EV_START, earlier], theta,
+                                 ev[ly.EV_HI, earlier], t, h, np.bool_(False), P, tab, kc, free,
+                                 ex, rec, mat, vec, stages, cg, cw, rg, ev)
+        if status != ly.OK:
+            return status, e, theta
+        e = earlier
+    return ly.OK, e, theta
 
 
 @nb.njit(**JIT)
@@ -300,6 +326,20 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             force = total_normal_force(rg)
             status, err, arg = step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
                                           cw, rg, ev, scale, ctl, t + h_try)
+        e = -1
+        theta = 2.0
+        if status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)):
+            ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
+            for k in range(ly.N_EV):
+                ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
+            status, e, theta = locate(t, h_try, np.bool_(True), P, tab, kc, free, ex, rec, mat,
+                                      vec, stages, cg, cw, rg, ev)
+            if status == ly.OK and e >= 0:
+                te = _event_time_error(e, theta * h_try, ev, ev_err)
+                r = te / (tol * EVENT_TIME_SCALE_S)
+                if r > err:
+                    err = r
+                    arg = ly.N_STATE + ly.N_EV
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
             ctl[ly.CTL_REJECTED] += 1.0
             ctl[ly.CTL_WORK] += 1.0
@@ -316,21 +356,13 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             st[ly.ST_T] = t
             return status, stored, n_log
         ctl[ly.CTL_WORK] += 1.0
-        _record_step(t, h_try, err, arg, dt, P, stages, ev, scale, ctl, floor_log, set_before,
-                     stick_before, rg, tol)
+        _record_step(t, h_try, err, arg, dt, stages, rg, scale, ctl, floor_log, set_before,
+                     stick_before)
         grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
         for k in range(ly.N_EV):
             ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
-        ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates, kept for the log
-        for k in range(ly.N_EV):
-            ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
-        status, e, theta = locate(t, h_try, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec,
-                                  stages, cg, cw, rg, ev)
-        if status != ly.OK:
-            st[ly.ST_T] = t
-            return status, stored, n_log
         if e >= 0:
-            te = _event_time_error(e, h_try, ev, ev_err)
+            te = _event_time_error(e, theta * h_try, ev, stages[ly.STAGE_TMP])
             ctl[ly.CTL_T_SSQ] += te * te
         t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
         if e < 0 and h_try == t_stop - t:
@@ -362,11 +394,17 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             # one step of the pair from the step's start to the event
             status, theta = _step_past(e, theta, t, h_try, P, tab, kc, free, ex, rec, mat, vec,
                                        stages, cg, cw, rg, ev, st)
+            if status == ly.OK:
+                status, e, theta = _earlier_on_steps(e, theta, t, h_try, P, tab, kc, free, ex,
+                                                     rec, mat, vec, stages, cg, cw, rg, ev)
             if status != ly.OK:
                 st[ly.ST_T] = t
                 return status, stored, n_log
             _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
-            t = t_end if theta >= 1.0 else t + theta * h_try
+            if theta < 1.0:
+                t = t + theta * h_try
+            else:
+                t = t_stop if h_try == t_stop - t else t + h_try
             for p in range(ly.N_POINTS):       # penetration when the event is found
                 if not in_set(int(rg[ly.RG_SET]), p):
                     _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t, 10 + p)

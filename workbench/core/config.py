@@ -148,9 +148,10 @@ PIVOT_REL = 1e-12
 NULL_COFACTOR_REL = 1e-12
 
 # --- controlled --------------------------------------------------------------
-#: An accepted interval whose estimate is below COARSEN_MARGIN / 2^p (p the
-#: order) lets the next one try a level coarser (a level divides the error by 2^p).
-COARSEN_MARGIN = 0.5
+#: An event's time is controlled on this scale (s): its estimated error (the
+#: event function's estimate over its rate) within tol times it, as the time
+#: of one sample of the default 1 kHz record.
+EVENT_TIME_SCALE_S = 1e-3
 #: Floors of the error scales: the clearance (cm) for positions (over a
 #: length for angles), and that times REF_RATE (1/s) for velocities.
 REF_RATE = 100.0
