@@ -42,7 +42,7 @@ from .error_scales import event_scale, floors, grow_scales, state_scale, total_n
 from .event_functions import event_values
 from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _penetration, _stepped,
                      _trial, apply_event, begin, flooding, locate, store)
-from .pair import dense, pair_step
+from .pair import dense, pair_step, prepare_dense
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
 #: h_new = h SAFETY err^-(1/p - 0.75 BETA) err_prev^BETA, by a factor in
@@ -53,7 +53,7 @@ BETA = 0.04
 FAC_MIN = 0.2
 FAC_MAX = 10.0
 #: Steps are at most this many base steps dt (the step at which RK4 is stable).
-MAX_STEP_FACTOR = 1.0
+MAX_STEP_FACTOR = 2.0
 #: The PI controller's memory before the first step (Hairer's facold).
 ERR_PREV_START = 1e-4
 #: Rows of the event log the driver keeps free before a step; below this it
@@ -328,6 +328,10 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
                                           cw, rg, ev, scale, ctl, t + h_try)
         e = -1
         theta = 2.0
+        if (status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9))
+                and P[ly.P_RK_EXTRA] > 0.0):
+            status = prepare_dense(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
+                                   cw, rg)
         if status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)):
             ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
             for k in range(ly.N_EV):

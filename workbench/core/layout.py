@@ -71,9 +71,9 @@ P_CORK_FORM = 43   # cork law's form: its index in workbench.core.cork.FORMS (st
 # workbench.model.tableaus.write_tableau (classical RK4 by default).  An
 # embedded pair (workbench.core.pair) adds its error weights e and its dense
 # output's coefficients (zeros for a tableau without them).
-MAX_RK_STAGES = 7
+MAX_RK_STAGES = 16
 #: Powers theta^1 .. theta^MAX_DENSE_DEGREE of a dense output's weights.
-MAX_DENSE_DEGREE = 5
+MAX_DENSE_DEGREE = 7
 P_RK_STAGES = 44   # number of stages s (stored as a float)
 P_RK_ORDER = 45    # order p: global error O(dt^p) (the controller's Richardson factor 2^p - 1)
 P_RK_C = 46        # P_RK_C + i: node c_i (-), i < MAX_RK_STAGES
@@ -82,7 +82,9 @@ P_RK_A = P_RK_B + MAX_RK_STAGES   # P_RK_A + MAX_RK_STAGES i + j: coefficient a_
 P_RK_E = P_RK_A + MAX_RK_STAGES * MAX_RK_STAGES   # P_RK_E + i: error weight e_i = b_i - bhat_i (-)
 P_RK_D = P_RK_E + MAX_RK_STAGES   # P_RK_D + MAX_DENSE_DEGREE i + j: dense weight of k_i, theta^(j+1)
 P_RK_DEGREE = P_RK_D + MAX_RK_STAGES * MAX_DENSE_DEGREE   # the dense output's degree (0: none)
-N_PARAMS = P_RK_DEGREE + 1
+P_RK_EXTRA = P_RK_DEGREE + 1      # stages computed for the dense output only (after the s of a step)
+P_RK_E3 = P_RK_EXTRA + 1          # P_RK_E3 + i: a second, lower-order error weight (DOP853's; 0: none)
+N_PARAMS = P_RK_E3 + MAX_RK_STAGES
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):

@@ -87,11 +87,47 @@ def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
     if status != ly.OK:
         return status
     err = stages[ly.STAGE_ERR]
+    second = P[ly.P_RK_E3] != 0.0
     for i in range(n):
         acc = 0.0
+        acc3 = 0.0
         for j in range(s):
             acc += P[ly.P_RK_E + j] * stages[j, i]
+            if second:
+                acc3 += P[ly.P_RK_E3 + j] * stages[j, i]
         err[i] = h * acc
+        if second:
+            # DOP853's estimate: e5^2 / sqrt(e5^2 + 0.01 e3^2), here per component (HNW I, §II.10)
+            d = math.sqrt(acc * acc + 0.01 * acc3 * acc3)
+            if d > 0.0:
+                err[i] *= abs(acc) / d
+    return ly.OK
+
+
+@nb.njit(**JIT)
+def prepare_dense(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg):
+    """The stages the dense output needs beyond the step's own (P[P_RK_EXTRA] of them).
+
+    Called after :func:`pair_step` from (t, y) with h, before :func:`dense`.
+    Returns a status.
+    """
+    s = int(P[ly.P_RK_STAGES])
+    yt = stages[ly.STAGE_TMP]
+    for r in range(s, s + int(P[ly.P_RK_EXTRA])):
+        row = ly.P_RK_A + ly.MAX_RK_STAGES * r
+        for i in range(ly.N_AUG):
+            yt[i] = 0.0
+        for j in range(r):
+            a = P[row + j]
+            if a != 0.0:
+                for i in range(ly.N_AUG):
+                    yt[i] += a * stages[j, i]
+        for i in range(ly.N_AUG):
+            yt[i] = y[i] + h * yt[i]
+        status = rhs_regime(t + P[ly.P_RK_C + r] * h, yt, P, tab, kc, free, ex, rec, mat, vec,
+                            cg, cw, rg, stages[r])
+        if status != ly.OK:
+            return status
     return ly.OK
 
 
@@ -101,7 +137,7 @@ def dense(theta, h, y, P, stages, out):
 
     The stages k_i must be those of that step (rows 0 .. s - 1).
     """
-    s = int(P[ly.P_RK_STAGES])
+    s = int(P[ly.P_RK_STAGES]) + int(P[ly.P_RK_EXTRA])
     degree = int(P[ly.P_RK_DEGREE])
     for i in range(ly.N_AUG):
         out[i] = y[i]

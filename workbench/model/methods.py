@@ -28,7 +28,7 @@ from typing import Callable
 
 from ..core.adaptive import run_adaptive
 from ..core.hybrid import run_hybrid
-from .tableaus import DOPRI5, RK4, Pair, Tableau
+from .tableaus import DOP853, DOPRI5, RK4, Pair, Tableau
 
 #: The smallest step by default: dt / 2^DEFAULT_LEVEL_MAX (3.9e-7 s from 1e-4 s); a step
 #: there is accepted whatever its estimate and reported (``floor_intervals``).
@@ -72,7 +72,10 @@ def register(method: Method) -> Method:
 register(Method("dopri5", DOPRI5, True,
                 "Dormand-Prince 5(4), steps chosen one at a time by its embedded estimate "
                 "against tol, events on its dense output", seconds_per_step=2e-5))
+register(Method("dop853", DOP853, True,
+                "Dormand-Prince 8(5,3), steps chosen by its embedded estimates against tol, events "
+                "on its dense output of order 7", seconds_per_step=2e-5))
 register(Method("rk4", RK4, False, "fixed-step RK4 (dt as given, or the stability step)",
                 seconds_per_step=2e-5))
 
-DEFAULT_METHOD = "dopri5"
+DEFAULT_METHOD = "dop853"

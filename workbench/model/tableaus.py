@@ -71,9 +71,8 @@ class Tableau:
                                                         for i, row in enumerate(self.a)):
             raise ValueError(f"tableau {self.name!r}: c needs {s} nodes and a row i needs i "
                              f"coefficients (explicit, strictly lower-triangular A)")
-        if not 1 <= self.order <= CHECKED_ORDER:
-            raise ValueError(f"tableau {self.name!r}: order {self.order}; orders 1 to "
-                             f"{CHECKED_ORDER} are checked and taken")
+        if not 1 <= self.order:
+            raise ValueError(f"tableau {self.name!r}: order {self.order}")
         b, c, a = np.array(self.b), np.array(self.c), self.matrix()
         if np.abs(a.sum(axis=1) - c).max() > _EPS:
             raise ValueError(f"tableau {self.name!r}: c_i must equal sum_j a_ij")
@@ -92,6 +91,7 @@ class Tableau:
 
 
 def _check_order(name, b, c, a, order):
+    """Butcher's conditions up to min(order, CHECKED_ORDER)."""
     for k, value, exact in _CONDITIONS:
         if k <= order and abs(value(b, c, a) - exact) > _EPS:
             raise ValueError(f"tableau {name!r} misses an order-{k} condition "
@@ -105,13 +105,19 @@ class Pair(Tableau):
     e: tuple[float, ...] = ()
     embedded_order: int = 0
     dense: tuple[tuple[float, ...], ...] = ()
+    #: stages for the dense output only, after the step's: (c, (a_0 .. a_{r-1}))
+    extra: tuple = ()
+    #: a second error weight (DOP853's third-order one), or none
+    e3: tuple[float, ...] = ()
 
     def __post_init__(self):
         super().__post_init__()
         s = self.stages
         b, c, a = np.array(self.b), np.array(self.c), self.matrix()
-        if len(self.e) != s or len(self.dense) != s:
-            raise ValueError(f"pair {self.name!r}: e and dense need {s} rows")
+        if len(self.e) != s or len(self.dense) != s + len(self.extra):
+            raise ValueError(f"pair {self.name!r}: e needs {s} rows, dense {s + len(self.extra)}")
+        if s + len(self.extra) > ly.MAX_RK_STAGES:
+            raise ValueError(f"pair {self.name!r}: more than {ly.MAX_RK_STAGES} stages")
         degree = len(self.dense[0])
         if not 1 <= degree <= ly.MAX_DENSE_DEGREE or any(len(r) != degree for r in self.dense):
             raise ValueError(f"pair {self.name!r}: dense weights of one degree, 1 to "
@@ -119,7 +125,8 @@ class Pair(Tableau):
         if b[-1] != 0.0 or c[-1] != 1.0 or np.abs(a[-1, :-1] - b[:-1]).max() > _EPS:
             raise ValueError(f"pair {self.name!r}: the last stage must be f(t + h, y_new) (FSAL)")
         _check_order(self.name, b - np.array(self.e), c, a, self.embedded_order)
-        if np.abs(np.sum(self.dense, axis=1) - b).max() > _EPS:
+        at_one = np.sum(self.dense, axis=1)
+        if np.abs(at_one[:s] - b).max() > _EPS or np.abs(at_one[s:]).max(initial=0.0) > _EPS:
             raise ValueError(f"pair {self.name!r}: the dense weights must equal b at theta = 1")
 
     @property
@@ -140,9 +147,17 @@ def write_tableau(P: np.ndarray, tableau: Tableau) -> None:
             P[ly.P_RK_A + m * i + j] = a_ij
     if isinstance(tableau, Pair):
         P[ly.P_RK_DEGREE] = tableau.degree
+        P[ly.P_RK_EXTRA] = len(tableau.extra)
         for i in range(tableau.stages):
             P[ly.P_RK_E + i] = tableau.e[i]
-            for j, d in enumerate(tableau.dense[i]):
+            if tableau.e3:
+                P[ly.P_RK_E3 + i] = tableau.e3[i]
+        for r, (c_r, row) in enumerate(tableau.extra, start=tableau.stages):
+            P[ly.P_RK_C + r] = c_r
+            for j, a_rj in enumerate(row):
+                P[ly.P_RK_A + m * r + j] = a_rj
+        for i, weights in enumerate(tableau.dense):
+            for j, d in enumerate(weights):
                 P[ly.P_RK_D + ly.MAX_DENSE_DEGREE * i + j] = d
 
 
@@ -178,3 +193,37 @@ DOPRI5 = Pair(
             701980252875 / 199316789632),
            (0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844),
            (0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423)))
+
+
+def _dop853() -> Pair:
+    """Dormand & Prince's 8(5,3) with its dense output of order 7 (Hairer, Norsett & Wanner I,
+    §II.10; the coefficients of scipy's integrate/_ivp/dop853_coefficients.py)."""
+    from numpy.polynomial import polynomial as poly
+    from scipy.integrate._ivp import dop853_coefficients as k
+    s = k.N_STAGES + 1                   # 12 stages and f(t + h, y_new)
+    a = tuple(tuple(float(x) for x in k.A[i, :i]) for i in range(s))
+    b = tuple(float(x) for x in k.B) + (0.0,)
+    extra = tuple((float(k.C[r]), tuple(float(x) for x in k.A[r, :r]))
+                  for r in range(s, k.N_STAGES_EXTENDED))
+    n = k.N_STAGES_EXTENDED
+    x, one_minus = np.array([0.0, 1.0]), np.array([1.0, -1.0])
+    phi = [x, poly.polymul(x, one_minus)]
+    for j in range(2, k.INTERPOLATOR_POWER):
+        phi.append(poly.polymul(phi[-1], x if j % 2 == 0 else one_minus))
+    bb = np.zeros(n)
+    bb[:s] = b
+    unit = np.eye(n)
+    weights = [bb, unit[0] - bb, 2 * bb - unit[s - 1] - unit[0], *k.D]
+    dense = np.zeros((n, k.INTERPOLATOR_POWER))
+    for f, w in zip(phi, weights):
+        coeffs = np.zeros(k.INTERPOLATOR_POWER + 1)
+        coeffs[:len(f)] = f
+        dense += np.outer(w, coeffs[1:])
+    return Pair("dop853", c=tuple(float(x) for x in k.C[:s]), a=a, b=b, order=8,
+                source="Hairer, Norsett & Wanner I, §II.10; scipy's dop853_coefficients",
+                e=tuple(float(x) for x in k.E5), embedded_order=5,
+                dense=tuple(tuple(r) for r in dense), extra=extra,
+                e3=tuple(float(x) for x in k.E3))
+
+
+DOP853 = _dop853()
