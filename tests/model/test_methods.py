@@ -19,7 +19,7 @@ from workbench.model import drives, methods
 from workbench.model.packing import build
 from workbench.model.params import Parameters
 from workbench.model.simulate import simulate
-from workbench.model.tableaus import DOPRI5, RK4, Pair, Tableau, write_tableau
+from workbench.model.tableaus import DOP853, DOPRI5, RK4, Pair, Tableau, write_tableau
 
 KUTTA3 = Tableau("kutta3", c=(0.0, 0.5, 1.0), a=((), (0.5,), (-1.0, 2.0)),
                  b=(1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0), order=3,
@@ -104,7 +104,7 @@ def test_the_tableau_is_written_where_the_kernels_read_it():
     assert not P[ly.P_RK_A:ly.P_RK_E].reshape(m, m)[3:].any()
     assert not P[ly.P_RK_E:].any()                  # no error weights, no dense output
     write_tableau(P, DOPRI5)
-    assert P[ly.P_RK_DEGREE] == 4 and list(P[ly.P_RK_E:ly.P_RK_E + m]) == list(DOPRI5.e)
+    assert P[ly.P_RK_DEGREE] == 4 and list(P[ly.P_RK_E:ly.P_RK_E + 7]) == list(DOPRI5.e)
 
 
 def test_a_tableau_that_misses_its_order_is_refused():
@@ -112,6 +112,43 @@ def test_a_tableau_that_misses_its_order_is_refused():
         Tableau("bad", KUTTA3.c, KUTTA3.a, KUTTA3.b, order=4, source="")
     with pytest.raises(ValueError, match="c_i must equal"):
         Tableau("bad", (0.0, 0.4, 1.0), KUTTA3.a, KUTTA3.b, order=1, source="")
-    with pytest.raises(ValueError, match="stages; the kernels take 1 to 7"):
-        Tableau("bad", (0.0,) * 8, tuple((0.0,) * i for i in range(8)), (1.0,) + (0.0,) * 7,
+    with pytest.raises(ValueError, match="stages; the kernels take 1 to 16"):
+        Tableau("bad", (0.0,) * 17, tuple((0.0,) * i for i in range(17)), (1.0,) + (0.0,) * 16,
                 order=1, source="")
+
+
+def test_dop853s_coefficients_are_scipys():
+    """The file the package reads DOP853 from (workbench/model/dop853.json) holds scipy's
+    coefficients, its dense output expanded per stage; the pair meets the order conditions
+    (to 5, checked when made) and its dense output equals scipy's interpolant."""
+    from scipy.integrate import DOP853 as ScipyDOP853
+
+    from workbench.model.tableaus import dop853_from_scipy
+    assert DOP853 == dop853_from_scipy()
+    # y' = [y1, -y0] one step of 0.3: the dense output at 0.37 against scipy's
+    solver = ScipyDOP853(lambda t, y: np.array([y[1], -y[0]]), 0.0, np.array([1.0, 0.0]), 1.0,
+                         first_step=0.3, max_step=0.3, rtol=1e-3, atol=1e-6)
+    solver.step()
+    h = solver.t - solver.t_old
+    interp = solver.dense_output()          # computes the three extra stages
+    k = np.array(solver.K_extended)
+    d = np.array(DOP853.dense)
+    theta = 0.37
+    ours = np.array([1.0, 0.0]) + h * (k.T @ (d @ theta ** np.arange(1, d.shape[1] + 1)))
+    np.testing.assert_allclose(ours, interp(solver.t_old + theta * h), rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("tableau, interval", [(RK4, 2.83), (DOP853, 5.96)], ids=lambda t: str(t))
+def test_a_pairs_largest_step_stays_inside_its_stability_interval(tableau, interval):
+    """|R(iy)| <= 1 up to the stability interval on the imaginary axis (where the beams'
+    lightly damped axial modes sit): RK4's 2.83 sets the base step, and a pair's steps go
+    up to max_step_factor base steps only inside its own (DOP853: 5.96 = 2.1 x RK4's)."""
+    a, b = tableau.matrix(), np.array(tableau.b)
+    s = len(b)
+
+    def r(y):
+        return abs(1 + 1j * y * b @ np.linalg.solve(np.eye(s) - 1j * y * a, np.ones(s)))
+    assert all(r(y) <= 1 + 1e-12 for y in np.linspace(0.01, interval - 0.01, 400))
+    assert r(interval + 0.05) > 1
+    factor = getattr(tableau, "max_step_factor", 1.0)
+    assert factor * 2.83 <= interval

@@ -52,8 +52,6 @@ SAFETY = 0.9
 BETA = 0.04
 FAC_MIN = 0.2
 FAC_MAX = 10.0
-#: Steps are at most this many base steps dt (the step at which RK4 is stable).
-MAX_STEP_FACTOR = 2.0
 #: The PI controller's memory before the first step (Hairer's facold).
 ERR_PREV_START = 1e-4
 #: Rows of the event log the driver keeps free before a step; below this it
@@ -275,6 +273,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
     for e in range(ly.N_EV):
         ev[ly.EV_NOISE, e] = tol * event_scale(e, P, scale, ctl)
     h_floor = dt / (1 << level_max)
+    h_max = max(P[ly.P_RK_STEP_FACTOR], 1.0) * dt
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
     err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
     t = t0
@@ -313,7 +312,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
                 stored += 1
                 b_next += decim
             continue
-        h_try = min(h, MAX_STEP_FACTOR * dt, t_stop - t)
+        h_try = min(h, h_max, t_stop - t)
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
         status = pair_step(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,

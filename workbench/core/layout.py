@@ -84,7 +84,8 @@ P_RK_D = P_RK_E + MAX_RK_STAGES   # P_RK_D + MAX_DENSE_DEGREE i + j: dense weigh
 P_RK_DEGREE = P_RK_D + MAX_RK_STAGES * MAX_DENSE_DEGREE   # the dense output's degree (0: none)
 P_RK_EXTRA = P_RK_DEGREE + 1      # stages computed for the dense output only (after the s of a step)
 P_RK_E3 = P_RK_EXTRA + 1          # P_RK_E3 + i: a second, lower-order error weight (DOP853's; 0: none)
-N_PARAMS = P_RK_E3 + MAX_RK_STAGES
+P_RK_STEP_FACTOR = P_RK_E3 + MAX_RK_STAGES   # a controlled step is at most this many base steps
+N_PARAMS = P_RK_STEP_FACTOR + 1
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):

@@ -19,7 +19,10 @@ and its dense output's weights (equal to b at theta = 1), and is FSAL.
 """
 from __future__ import annotations
 
+import dataclasses
+import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -109,6 +112,9 @@ class Pair(Tableau):
     extra: tuple = ()
     #: a second error weight (DOP853's third-order one), or none
     e3: tuple[float, ...] = ()
+    #: its steps are at most this many base steps (the step at which RK4 is stable): the
+    #: ratio of its stability interval on the imaginary axis to RK4's (2.83), rounded down
+    max_step_factor: float = 1.0
 
     def __post_init__(self):
         super().__post_init__()
@@ -148,6 +154,7 @@ def write_tableau(P: np.ndarray, tableau: Tableau) -> None:
     if isinstance(tableau, Pair):
         P[ly.P_RK_DEGREE] = tableau.degree
         P[ly.P_RK_EXTRA] = len(tableau.extra)
+        P[ly.P_RK_STEP_FACTOR] = tableau.max_step_factor
         for i in range(tableau.stages):
             P[ly.P_RK_E + i] = tableau.e[i]
             if tableau.e3:
@@ -195,9 +202,15 @@ DOPRI5 = Pair(
            (0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423)))
 
 
-def _dop853() -> Pair:
+def dop853_from_scipy() -> Pair:
     """Dormand & Prince's 8(5,3) with its dense output of order 7 (Hairer, Norsett & Wanner I,
-    §II.10; the coefficients of scipy's integrate/_ivp/dop853_coefficients.py)."""
+    §II.10), from the coefficients of scipy's integrate/_ivp/dop853_coefficients.py.
+
+    scipy writes the interpolant as y0 + x (F0 + (1 - x)(F1 + x (F2 + ...))) with F0 = dy,
+    F1 = h k1 - dy, F2 = 2 dy - h (k_new + k1), F3..F6 = h D k; here it is expanded into each
+    stage's weight as a polynomial in theta.  The estimate is DOP853's: per component
+    e5^2 / sqrt(e5^2 + 0.01 e3^2) (workbench.core.pair).
+    """
     from numpy.polynomial import polynomial as poly
     from scipy.integrate._ivp import dop853_coefficients as k
     s = k.N_STAGES + 1                   # 12 stages and f(t + h, y_new)
@@ -220,10 +233,27 @@ def _dop853() -> Pair:
         coeffs[:len(f)] = f
         dense += np.outer(w, coeffs[1:])
     return Pair("dop853", c=tuple(float(x) for x in k.C[:s]), a=a, b=b, order=8,
-                source="Hairer, Norsett & Wanner I, §II.10; scipy's dop853_coefficients",
-                e=tuple(float(x) for x in k.E5), embedded_order=5,
-                dense=tuple(tuple(r) for r in dense), extra=extra,
-                e3=tuple(float(x) for x in k.E3))
+                source=DOP853_SOURCE, e=tuple(float(x) for x in k.E5), embedded_order=5,
+                dense=tuple(tuple(float(v) for v in r) for r in dense), extra=extra,
+                e3=tuple(float(x) for x in k.E3), max_step_factor=2.0)
 
 
-DOP853 = _dop853()
+DOP853_SOURCE = ("Dormand & Prince 8(5,3) with its dense output of order 7; Hairer, Norsett & "
+                 "Wanner I, §II.10; coefficients as scipy's integrate/_ivp/dop853_coefficients.py")
+#: DOP853's coefficients, written by ``python -m workbench.model.tableaus`` from scipy's (read at
+#: import they would cost every process scipy.integrate's 0.35 s); tests/model/test_methods.py
+#: checks them against scipy's.
+DOP853_FILE = Path(__file__).with_name("dop853.json")
+
+
+def _pair_from_file(path: Path) -> Pair:
+    data = json.loads(path.read_text())
+    def tuples(x):
+        return tuple(tuples(v) for v in x) if isinstance(x, list) else x
+    return Pair(**{key: tuples(value) for key, value in data.items()})
+
+
+DOP853 = _pair_from_file(DOP853_FILE)
+
+if __name__ == "__main__":
+    DOP853_FILE.write_text(json.dumps(dataclasses.asdict(dop853_from_scipy())) + "\n")
