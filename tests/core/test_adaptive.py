@@ -1,6 +1,6 @@
-"""The default method (workbench.core.adaptive, workbench.core.pair): Dormand-Prince 5(4)
-steps chosen by their embedded estimate, events on its dense output, against fixed RK4 and
-closed forms."""
+"""The controlled methods (workbench.core.adaptive, workbench.core.pair): Dormand-Prince 8(5,3)
+(the default) and 5(4) steps chosen by their embedded estimates, events on their dense output,
+against fixed RK4 and closed forms."""
 import math
 
 import numpy as np
@@ -33,7 +33,7 @@ def rocking():
 def test_the_same_input_gives_bit_identical_output(rocking):
     p, ex = rocking
     a, b = (simulate(p, ex, 0.1, initial="paper") for _ in range(2))
-    assert a.method == "dopri5" and a.tol == DEFAULT_TOL
+    assert a.method == "dop853" and a.tol == DEFAULT_TOL
     assert len(a.events) > 20
     assert np.array_equal(a.states, b.states) and np.array_equal(a.log, b.log)
     assert a.control == b.control
@@ -114,7 +114,7 @@ def test_frictionless_slide_on_a_stiff_cork_stays_within_the_tolerance_closed_fo
     for tol in (1e-4, 1e-8):
         run = simulate(p, None, 0.1, dt=1e-3, tol=tol, output_hz=1000, initial=q0,
                        fixed=held_except("s", "v"), regime=9)
-        assert run.ok and run.method == "dopri5", run.message
+        assert run.ok and run.method == "dop853", run.message
         assert set(run.events.kind) <= {"start", "slip-stick"}   # reversals; it never leaves
         sig = run.signals
         s, sd = sig.s.to_numpy(), sig.s_dot.to_numpy()
@@ -181,7 +181,7 @@ def test_a_gap_dipping_below_zero_inside_one_step_is_an_impact():
 def test_falling_across_the_gap_closed_form():
     p = Parameters()
     run = simulate(p, None, 0.05, initial=np.zeros(18), fixed=held_except("v"))
-    assert run.ok and run.method == "dopri5", run.message
+    assert run.ok and run.method == "dop853", run.message
     impacts = run.events[run.events.kind == "impact"]
     assert len(impacts) == 1
     assert abs(impacts.t.iloc[0] - math.sqrt(p.gap / p.g)) < 1e-9   # gap/2 = g t^2 / 2
@@ -206,7 +206,7 @@ def test_cli_run_reports_the_integrators_account(capsys):
     rc = main(["run", "--gap-mm", "1.016", "--freq-hz", "20", "--force-n", "20", "--duration",
                "0.05", "--tol", "1e-5", "--json"])
     out = json.loads(capsys.readouterr().out)
-    assert rc == 0 and out["method"] == "dopri5" and out["tol"] == 1e-5
+    assert rc == 0 and out["method"] == "dop853" and out["tol"] == 1e-5
     for key in ("steps", "rejected", "h_min", "h_max", "error_est_max", "floor_count",
                 "floor_intervals"):
         assert key in out

@@ -152,3 +152,26 @@ def test_a_pairs_largest_step_stays_inside_its_stability_interval(tableau, inter
     assert r(interval + 0.05) > 1
     factor = getattr(tableau, "max_step_factor", 1.0)
     assert factor * 2.83 <= interval
+
+
+@pytest.mark.parametrize("pair, order", [(DOPRI5, 4), (DOP853, 7)], ids=lambda p: str(p))
+def test_a_pairs_dense_output_has_its_order(pair, order):
+    """y' = i y from y(0) = 1: one step of h, the dense output at theta = 0.4 against
+    exp(0.4 i h); the local error of an interpolant of order p is O(h^(p+1)) (the extra
+    stages, after the step's, evaluated as the step's are)."""
+    a = np.zeros((pair.stages + len(pair.extra),) * 2)
+    a[:pair.stages, :pair.stages] = pair.matrix()
+    for r, (_, row) in enumerate(pair.extra, start=pair.stages):
+        a[r, :r] = row
+    d = np.array(pair.dense)
+    errors = []
+    hs = np.array([0.4, 0.2, 0.1]) if order > 5 else np.array([0.1, 0.05, 0.025])
+    for h in hs:
+        k = np.zeros(len(a), dtype=complex)
+        for i in range(len(a)):
+            k[i] = 1j * (1.0 + h * a[i, :i] @ k[:i])
+        theta = 0.4
+        y = 1.0 + h * k @ (d @ theta ** np.arange(1, d.shape[1] + 1))
+        errors.append(abs(y - np.exp(1j * theta * h)))
+    slope = np.polyfit(np.log(hs), np.log(errors), 1)[0]
+    assert abs(slope - (order + 1)) < 0.3, (slope, errors)

@@ -53,7 +53,7 @@ def test_the_default_tolerance_takes_the_references_events(both):
     reference, in order, within 1e-6 s."""
     ref_log = both[1]
     run = simulate(Parameters(), None, HORIZON, initial="paper")
-    assert run.ok and run.method == "dopri5" and run.control["floor_count"] == 0
+    assert run.ok and run.method == "dop853" and run.control["floor_count"] == 0
     ev = run.events[run.events.kind != "start"]
     assert len(ev) == len(ref_log)
     for k, r in zip(ev.itertuples(), ref_log):

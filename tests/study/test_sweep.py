@@ -70,7 +70,7 @@ def test_small_grid_end_to_end(small_run):
     on_disk = pd.read_parquet(root / "res1" / "small" / "points.parquet")
     pd.testing.assert_frame_equal(on_disk, table)
     # each point keeps the integrator's account: the default method met its tolerance
-    assert (table.method == "dopri5").all() and (table.tol == study.tol).all()
+    assert (table.method == "dop853").all() and (table.tol == study.tol).all()
     assert (table.error_over_tol_max <= 1.0).all() and (table.floor_count == 0).all()
     assert (table.steps_all >= table.steps).all() and (table.h_min <= table.h_max).all()
     series = sorted(p.name for p in (root / "res1" / "small" / "series").iterdir())

@@ -167,8 +167,9 @@ def add_parsers(sub) -> None:
                      help="fixed RK4 step (s; implies --method rk4 unless --tol is given); default "
                      "from the model's fastest mode")
     run.add_argument("--method", default=None,
-                     help="integration method: dopri5 (default: Dormand-Prince 5(4) steps chosen "
-                     "by the error against --tol) or rk4 (fixed steps of --dt)")
+                     help="integration method: dop853 (default: Dormand-Prince 8(5,3) steps chosen "
+                     "by the error against --tol), dopri5 (5(4), the same way) or rk4 (fixed "
+                     "steps of --dt)")
     run.add_argument("--tol", type=number(0, lo_open=True), default=None,
                      help=f"relative tolerance of the controlled method (default {DEFAULT_TOL:g}; "
                      "docs/model.md 'Integration')")

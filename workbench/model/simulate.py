@@ -410,7 +410,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     ``t0`` (s) is the start time: the run covers [t0, t0 + duration] and the
     excitation is evaluated at those times (e.g. to continue from a state
     of an earlier run, given as ``initial`` with its ``regime``).
-    ``method`` (:mod:`workbench.model.methods`): "dopri5" (the default)
+    ``method`` (:mod:`workbench.model.methods`): "dop853" (the default) or "dopri5"
     chooses the steps by an error estimate against the relative tolerance
     ``tol`` (default DEFAULT_TOL), from dt down to dt / 2^level_max; "rk4" takes
     fixed RK4 steps of dt, and is the default when ``dt`` is given without

@@ -6,7 +6,7 @@
     window_s = 2.0                   # steady-state window at the end of each point (s)
     sweep = "independent"            # or "up", "down", "up-down" (stepped frequency sweeps)
     tol = 1e-4                       # optional tolerance of the controlled method (the default)
-    method = "dopri5"                # optional: "dopri5" (controlled), or "rk4" (fixed steps of dt)
+    method = "dop853"                # optional: "dop853", "dopri5" (controlled), or "rk4" (fixed dt)
     dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
                                      # controlled method's largest; default: simulate.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
@@ -111,7 +111,7 @@ class Study:
     axes: dict
     save_series: tuple = ()
     source: str = ""
-    method: str = "dopri5"
+    method: str = "dop853"
     tol: float | None = None
     tip_limit_cm: float | None = None
     check_accuracy: bool = False
