@@ -24,6 +24,7 @@ import importlib
 import sys
 
 import llvmlite.binding as ll
+import numba as nb
 from numba.core import caching, codegen
 from numba.core.registry import CPUDispatcher
 
@@ -126,6 +127,16 @@ def install() -> None:
     caching.CompileResultCacheImpl.rebuild = _rebuild
 
 
+def type_name(t) -> str:
+    """A numba type as text that evaluates back to it (numba.types' names, and a named
+    tuple's class by its module and name: ``NamedTuple((...), workbench.model.packing.Model)``)."""
+    if isinstance(t, nb.types.BaseNamedTuple):
+        cls = t.instance_class
+        return (f"NamedTuple(({', '.join(type_name(x) for x in t.types)},), "
+                f"{cls.__module__}.{cls.__qualname__})")
+    return repr(t)
+
+
 def kernel_graph() -> dict:
     """Every kernel compiled or loaded in this process: {"module.function":
     {"signature": [numba type names], "links": ["module.function", ...]}} (one
@@ -135,7 +146,7 @@ def kernel_graph() -> dict:
     for module, attr, disp in _dispatchers():
         for sig, cres in disp.overloads.items():
             out[f"{module.rsplit('.', 1)[-1]}.{attr}"] = {
-                "signature": [repr(t) for t in sig],
+                "signature": [type_name(t) for t in sig],
                 "links": sorted({f"{m.rsplit('.', 1)[-1]}.{a}"
                                  for m, a, _s in linked_kernels(cres.library)})}
     return out

@@ -107,7 +107,18 @@ def _compile(name: str, signature) -> None:
     import numba
     module, function = name.rsplit(".", 1)
     kernel = getattr(importlib.import_module(f"workbench.core.{module}"), function)
-    kernel.compile(tuple(eval(t, vars(numba.types)) for t in signature))
+    kernel.compile(tuple(eval_type(t) for t in signature))
+
+
+def eval_type(text: str):
+    """A numba type from its name in the plan (workbench.core._linking.type_name)."""
+    import importlib
+    import numba
+    namespace = dict(vars(numba.types))
+    for module in ("workbench",):
+        namespace[module] = importlib.import_module(module)
+    importlib.import_module("workbench.model.packing")      # named tuples of the kernels
+    return eval(text, namespace)
 
 
 def _claim(path: Path) -> bool:
