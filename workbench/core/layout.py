@@ -75,7 +75,7 @@ MAX_RK_STAGES = 16
 #: Powers theta^1 .. theta^MAX_DENSE_DEGREE of a dense output's weights.
 MAX_DENSE_DEGREE = 7
 P_RK_STAGES = 44   # number of stages s (stored as a float)
-P_RK_ORDER = 45    # order p: global error O(dt^p) (the controller's Richardson factor 2^p - 1)
+P_RK_ORDER = 45    # order p: global error O(dt^p) (the PI controller's exponents)
 P_RK_C = 46        # P_RK_C + i: node c_i (-), i < MAX_RK_STAGES
 P_RK_B = P_RK_C + MAX_RK_STAGES   # P_RK_B + i: weight b_i (-)
 P_RK_A = P_RK_B + MAX_RK_STAGES   # P_RK_A + MAX_RK_STAGES i + j: coefficient a_ij (-), j < i
@@ -307,40 +307,30 @@ ST_FLOOD_N = 21      # events in that window
 ST_STEPPED_UNTIL = 22    # Moreau-Jean time-stepping runs until this time (s) after a flood
 N_ST = 23
 
-# --- the error-controlled integration (workbench.core.controlled) --------------
-# Snapshots snap (N_SNAP, N_AUG): an interval's start and the end of its
-# coarse path, each SNAP_ROWS rows: the state, its k1, the events' start
-# values and gap rates, the regime record, the run statistics, and
-# (SNAP_MISC) the time and the Moreau-Jean steps left.
-SNAP_Y, SNAP_K1, SNAP_EV, SNAP_EVR, SNAP_RG, SNAP_ST, SNAP_MISC = range(7)
-SNAP_ROWS = 7
-SNAP_START = 0
-SNAP_COARSE = SNAP_ROWS
-N_SNAP = 2 * SNAP_ROWS
+# --- the error-controlled integration (workbench.core.adaptive) ----------------
 # Controller record ctl (N_CTL,): its state between calls and its statistics.
-CTL_LEVEL = 0        # level k of the current pair: coarse steps dt / 2^k, fine dt / 2^(k+1)
-CTL_STEPS = 1        # lattice steps of the accepted (fine) paths
-CTL_WORK = 2         # lattice steps taken in all (coarse, fine and rejected paths)
-CTL_INTERVALS = 3    # control intervals accepted
-CTL_REJECTED = 4     # control intervals redone with a finer pair
+CTL_STEPS = 1        # accepted steps
+CTL_WORK = 2         # steps tried (accepted and rejected)
+CTL_INTERVALS = 3    # accepted steps (the summary's "intervals")
+CTL_REJECTED = 4     # rejected steps
 CTL_H_MIN = 5        # smallest accepted step (s)
 CTL_H_MAX = 6        # largest accepted step (s)
-CTL_ERR_MAX = 7      # largest error estimate of an accepted interval, over the tolerance
-CTL_T_ERR_MAX = 8    # the start of that interval (s)
-CTL_N_FLOOR = 9      # intervals accepted at the finest level above the tolerance
-CTL_F_SCALE = 10     # largest total normal contact force at an interval's end (dyn)
-CTL_ARG_ERR_MAX = 11     # what set CTL_ERR_MAX: a component of (q, q'), or N_STATE + an event
-CTL_REJECTED_EVENTS = 12  # rejections because the two paths' event sequences differed
-CTL_LEVELS = 13      # CTL_LEVELS + j: intervals accepted with fine steps dt / 2^j (j < N_CTL_LEVELS)
+CTL_ERR_MAX = 7      # largest error estimate of an accepted step, over the tolerance
+CTL_T_ERR_MAX = 8    # the start of that step (s)
+CTL_N_FLOOR = 9      # steps accepted at the smallest size above the tolerance
+CTL_F_SCALE = 10     # largest total normal contact force at a step's end (dyn)
+CTL_ARG_ERR_MAX = 11     # what set CTL_ERR_MAX: a component of (q, q'), N_STATE + an event,
+                         # or N_STATE + N_EV an event's time
+CTL_REJECTED_EVENTS = 12  # rejections set by an event function or an event's time
+CTL_LEVELS = 13      # CTL_LEVELS + j: steps accepted in (dt / 2^(j+1), dt / 2^j] (j = 0: above)
 N_CTL_LEVELS = 10
-# Sums of squares of the accepted intervals' local estimates (Richardson's,
-# not over the tolerance): the largest relative error of a position q_i (over
-# its scale) per interval, and each event's time error (s).
+# Sums of squares of the accepted steps' local estimates (not over the
+# tolerance): the largest relative error of a position q_i (over its scale)
+# per step, and each event's time error (s).
 CTL_Q_SSQ = CTL_LEVELS + N_CTL_LEVELS
 CTL_T_SSQ = CTL_Q_SSQ + 1
-# The embedded pair's controller (workbench.core.adaptive) between calls: the
-# next step to try (s; 0 before the first) and the last accepted estimate
-# over the tolerance (the PI controller's memory).
+# The next step to try (s; 0 before the first) and the last accepted
+# estimate over the tolerance (the PI controller's memory), between calls.
 CTL_H_NEXT = CTL_T_SSQ + 1
 CTL_ERR_PREV = CTL_H_NEXT + 1
 N_CTL = CTL_ERR_PREV + 1
@@ -348,10 +338,9 @@ N_CTL = CTL_ERR_PREV + 1
 # component of (q, q'), row SCALE_PEAK its largest |value| so far.
 SCALE_FLOOR, SCALE_PEAK = 0, 1
 N_SCALE_ROWS = 2
-# Intervals accepted at the floor floor_log (capacity, N_FLOOR): where, the
-# regimes at its ends, the events of its accepted path, the estimate over
-# the tolerance (-1: none, the two paths' regime sequences differ or a path
-# took Moreau-Jean steps), and the Moreau-Jean steps of the accepted path.
+# Steps accepted at the smallest size above the tolerance, floor_log
+# (capacity, N_FLOOR): where, the regimes at its ends, events (0), the
+# estimate over the tolerance, and Moreau-Jean steps (0).
 FL_T0, FL_T1, FL_FROM, FL_TO, FL_EVENTS, FL_ERR, FL_STEPPED = range(7)
 N_FLOOR = 7
 

@@ -569,10 +569,11 @@ def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: floa
                     duration: float) -> dict:
     """The controlled run's steps, rejections and error estimates (Run.summary keys).
 
-    ``intervals_by_step`` counts the control intervals accepted at each
-    step (s) of the lattice of base step dt.  Besides the largest local
+    ``intervals_by_step`` counts the steps accepted in each band
+    (dt / 2^(j+1), dt / 2^j] (s; base step dt, steps above dt in the
+    first).  Besides the largest local
     estimate, the run's global error is estimated as the root sum of
-    squares of the accepted intervals' local estimates (local errors of
+    squares of the accepted steps' local estimates (local errors of
     random sign): ``q_error_rss`` for the positions (relative to their
     scales, as the tip's error relative to its range) and
     ``share_error_rss`` for the contact codes' time shares (the events'

@@ -205,9 +205,9 @@ def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
     over = ok[(ok.error_over_tol_max > 1.0) | (ok.floor_count > 0)]
     if len(over):
         lines += ["## Points above their tolerance", "",
-                  "Each has control intervals that met the tolerance only at the finest step, "
-                  "or not at all (`run.control['floor_intervals']` lists them).", "",
-                  "| point | estimate / tol | intervals at the floor |", "|---|---|---|"]
+                  "Each has steps accepted at the smallest size above the tolerance "
+                  "(`run.control['floor_intervals']` lists them).", "",
+                  "| point | estimate / tol | steps at the floor |", "|---|---|---|"]
         lines += [f"| {point_title(r)} | {r.error_over_tol_max:.3g} | {int(r.floor_count)} |"
                   for _, r in over.iterrows()]
         lines.append("")
