@@ -41,7 +41,7 @@ from .contact import in_set, regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
 from .event_functions import event_values
 from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _penetration, _stepped,
-                     _trial, apply_event, begin, flooding, locate, store)
+                     _trial, apply_event, begin, flooding, locate, passed_before, store)
 from .pair import dense, pair_step, prepare_dense
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
@@ -213,11 +213,7 @@ def _earlier_on_steps(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stage
     first.  Returns ``(status, event, theta)``, the state past it in STAGE_HI.
     """
     for _ in range(ly.N_EV):
-        earlier = -1
-        for k in range(ly.N_EV):
-            if k != e and ev[ly.EV_START, k] >= 0.0 and ev[ly.EV_HI, k] < 0.0:
-                earlier = k
-                break
+        earlier = passed_before(e, ev)
         if earlier < 0:
             break
         status, theta = _bracket(earlier, ev[ly.EV_START, earlier], theta,

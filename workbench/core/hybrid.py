@@ -1,22 +1,15 @@
 """Event-driven integration of the 17-regime model (docs/model.md §7), jit-compiled.
 
-Steps of the step method (:func:`workbench.core.integrate.rk_step`, the
-tableau in P) in the current regime; after each step the events of the
-regime are evaluated (every event function goes from + to - when its event
-happens, layout ``EV_*``):
-
-    open gap g_k + arm_k                    impact of point k (arm_k: GAP_EPS, or
-                                            the depth at which a released point
-                                            left, rg[RG_ARM + k])
-    lambda_n,k + LAMBDA_EPS, active k       separation of point k (or, in a sticking
-                                            double contact, the move of its
-                                            tangential row to the other point)
-    mu_s sum lambda_n - |lambda_t| + tol    stick -> slip (tol: FRICTION_REL_EPS)
-    sigma tau' + RATE_EPS                   slip -> stick (or reversal)
+Fixed steps of the step method (:func:`workbench.core.integrate.rk_step`,
+the tableau in P) in the current regime (:func:`run_hybrid`,
+:func:`advance`); after each step the events of the regime are evaluated
+(:mod:`workbench.core.event_functions`: each goes from + to - when its
+event happens).  The location and the transitions here serve the
+controlled steps of :mod:`workbench.core.adaptive` too.
 
 A sign change is bracketed by re-integrating the partial step from the
-step's start (one step of theta dt) and located by Brent's method to
-EVENT_TIME_TOL.  A gap that dips below zero and back within one step
+step's start (one step of theta dt), or on the dense output of the step
+just taken, and located by Brent's method to EVENT_TIME_TOL.  A gap that dips below zero and back within one step
 (grazing) is caught by the cubic Hermite interpolant of the gap over the
 step: near its minimum the true gap is evaluated by re-integration and its
 minimum followed by the secant method on the gap's rate (:func:`_graze`).  Several events in a
@@ -298,6 +291,16 @@ def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     return ly.OK, -1.0
 
 
+@nb.njit(**JIT_INLINE)
+def passed_before(e, ev):
+    """An event other than e positive at the step's start and negative at the state in EV_HI
+    (-1 if none)."""
+    for k in range(ly.N_EV):
+        if k != e and ev[ly.EV_START, k] >= 0.0 and ev[ly.EV_HI, k] < 0.0:
+            return k
+    return -1
+
+
 @nb.njit(**JIT)
 def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
     """The earliest event in the step (t, t + h) from STAGE_CUR to STAGE_NEXT.
@@ -367,11 +370,7 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     for _ in range(ly.N_EV):
         if best < 0:
             break
-        earlier = -1
-        for e in range(ly.N_EV):
-            if e != best and ev[ly.EV_START, e] >= 0.0 and ev[ly.EV_HI, e] < 0.0:
-                earlier = e
-                break
+        earlier = passed_before(best, ev)
         if earlier < 0:
             break
         status, hi = _bracket(earlier, ev[ly.EV_START, earlier], best_theta,

@@ -18,9 +18,25 @@ import math
 
 import numba as nb
 
-from .config import JIT
+from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .constrained import rhs_regime
+
+
+@nb.njit(**JIT_INLINE)
+def stage_state(r, t, y, h, P, stages, yt):
+    """Stage r's state y + h sum_{j<r} a_rj k_j (k_j in stages[j]) into yt; returns its time."""
+    row = ly.P_RK_A + ly.MAX_RK_STAGES * r
+    for i in range(ly.N_AUG):
+        yt[i] = 0.0
+    for j in range(r):
+        a = P[row + j]
+        if a != 0.0:
+            for i in range(ly.N_AUG):
+                yt[i] += a * stages[j, i]
+    for i in range(ly.N_AUG):
+        yt[i] = y[i] + h * yt[i]
+    return t + P[ly.P_RK_C + r] * h
 
 
 @nb.njit(**JIT)
@@ -37,18 +53,8 @@ def rk_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, y
     for i in range(n):
         stages[0, i] = stages[ly.STAGE_K1, i]
     for st in range(1, s):
-        row = ly.P_RK_A + ly.MAX_RK_STAGES * st
-        for i in range(n):
-            yt[i] = 0.0
-        for j in range(st):
-            a = P[row + j]
-            if a != 0.0:
-                for i in range(n):
-                    yt[i] += a * stages[j, i]
-        for i in range(n):
-            yt[i] = y[i] + dt * yt[i]
-        status = rhs_regime(t + P[ly.P_RK_C + st] * dt, yt, P, tab, kc, free, ex, rec, mat, vec,
-                            cg, cw, rg, stages[st])
+        status = rhs_regime(stage_state(st, t, y, dt, P, stages, yt), yt, P, tab, kc, free, ex,
+                            rec, mat, vec, cg, cw, rg, stages[st])
         if status != ly.OK:
             return status
     for i in range(n):

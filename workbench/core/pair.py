@@ -26,6 +26,7 @@ from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .constrained import project, rhs_regime
 from .event_functions import event_values
+from .integrate import stage_state
 
 
 @nb.njit(**JIT_INLINE)
@@ -56,19 +57,9 @@ def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
         ev[ly.EV_MIN, e] = ev[ly.EV_START, e]
     for i in range(n):
         stages[0, i] = stages[ly.STAGE_K1, i]
-    for st_ in range(1, s - 1):
-        row = ly.P_RK_A + ly.MAX_RK_STAGES * st_
-        for i in range(n):
-            yt[i] = 0.0
-        for j in range(st_):
-            a = P[row + j]
-            if a != 0.0:
-                for i in range(n):
-                    yt[i] += a * stages[j, i]
-        for i in range(n):
-            yt[i] = y[i] + h * yt[i]
-        status = rhs_regime(t + P[ly.P_RK_C + st_] * h, yt, P, tab, kc, free, ex, rec, mat, vec,
-                            cg, cw, rg, stages[st_])
+    for r in range(1, s - 1):
+        status = rhs_regime(stage_state(r, t, y, h, P, stages, yt), yt, P, tab, kc, free, ex,
+                            rec, mat, vec, cg, cw, rg, stages[r])
         if status != ly.OK:
             return status
         _stage_events_min(yt, P, free, cg, rg, ev)
@@ -114,18 +105,8 @@ def prepare_dense(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     s = int(P[ly.P_RK_STAGES])
     yt = stages[ly.STAGE_TMP]
     for r in range(s, s + int(P[ly.P_RK_EXTRA])):
-        row = ly.P_RK_A + ly.MAX_RK_STAGES * r
-        for i in range(ly.N_AUG):
-            yt[i] = 0.0
-        for j in range(r):
-            a = P[row + j]
-            if a != 0.0:
-                for i in range(ly.N_AUG):
-                    yt[i] += a * stages[j, i]
-        for i in range(ly.N_AUG):
-            yt[i] = y[i] + h * yt[i]
-        status = rhs_regime(t + P[ly.P_RK_C + r] * h, yt, P, tab, kc, free, ex, rec, mat, vec,
-                            cg, cw, rg, stages[r])
+        status = rhs_regime(stage_state(r, t, y, h, P, stages, yt), yt, P, tab, kc, free, ex,
+                            rec, mat, vec, cg, cw, rg, stages[r])
         if status != ly.OK:
             return status
     return ly.OK
