@@ -1,9 +1,9 @@
-"""Whole runs at the default settings: the controlled method beside fixed RK4, side by side.
+"""Whole runs at the default settings: the default method beside fixed RK4, side by side.
 
     python benchmarks/controlled_speed.py [--rounds 3] [--chirp]
 
 The 10 s sines (1.016 mm, 20 Hz, 200 N, cubic cork, 1 s ramp) with and
-without the tip mass, each run in turn by the controlled method at its
+without the tip mass, each run in turn by the default method at its
 default tolerance and by fixed RK4 at the default step and at a quarter of
 it, ROUNDS times alternately; prints the median wall, simulated seconds per
 wall second, events, the controlled run's steps (accepted and in all) and
@@ -32,7 +32,7 @@ def cases(with_chirp: bool) -> dict:
 
 def methods(p, ex) -> dict:
     dt = default_dt(p, ex)
-    return {"controlled": {}, "rk4 dt": {"dt": dt}, "rk4 dt/4": {"dt": dt / 4}}
+    return {"default": {}, "rk4 dt": {"dt": dt}, "rk4 dt/4": {"dt": dt / 4}}
 
 
 def main(argv=None) -> int:

@@ -27,7 +27,7 @@ from workbench.model.simulate import default_dt, simulate
 STEP_FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 LSODA_RTOLS = (1e-2, 1e-3, 1e-4, 1e-6)
 #: The controlled method's tolerances on the windows (the default among them).
-TOLS = (1e-3, DEFAULT_TOL, 1e-5)
+TOLS = (1e-4, DEFAULT_TOL, 1e-6)
 WINDOW_CASES = ("sine-tip", "sine-no-tip")
 WHOLE_ROUNDS = {"sine-tip": 5, "sine-no-tip": 5, "chirp": 1}
 
