@@ -52,6 +52,7 @@ SAFETY = 0.9
 BETA = 0.04
 FAC_MIN = 0.2
 FAC_MAX = 10.0
+ALIGN = 0.5
 #: The PI controller's memory before the first step (Hairer's facold).
 ERR_PREV_START = 1e-4
 #: Rows of the event log the driver keeps free before a step; below this it
@@ -92,6 +93,20 @@ def step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
             worst = r
             arg = ly.N_STATE + e
     return ly.OK, worst, arg
+
+
+@nb.njit(**JIT_INLINE)
+def _needs_dense(ev):
+    """Will :func:`workbench.core.hybrid.locate` look inside the step (its dense output)?"""
+    for e in range(ly.N_EV):
+        if ev[ly.EV_START, e] < 0.0:
+            continue
+        if ev[ly.EV_END, e] < 0.0 or ev[ly.EV_MIN, e] < -ev[ly.EV_NOISE, e]:
+            return True
+        if (e < ly.EV_GAP + ly.N_POINTS and ev[ly.EV_RATE_START, e] < 0.0
+                and ev[ly.EV_RATE_END, e] > 0.0 and ev[ly.EV_START, e] < 1.0):
+            return True
+    return False
 
 
 @nb.njit(**JIT_INLINE)
@@ -309,6 +324,10 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
                 b_next += decim
             continue
         h_try = min(h, h_max, t_stop - t)
+        if b_next <= m_stop:                # end on the next sample when it is near the end
+            gap_s = t0 + (b_next - step0) * dt - t
+            if ALIGN * h_try <= gap_s < h_try:
+                h_try = gap_s
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
         status = pair_step(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
@@ -324,7 +343,9 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
         e = -1
         theta = 2.0
         if (status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9))
-                and P[ly.P_RK_EXTRA] > 0.0):
+                and P[ly.P_RK_EXTRA] > 0.0
+                and (_needs_dense(ev) or (b_next <= m_stop and t0 + (b_next - step0) * dt
+                                          < t + h_try * (1.0 - 1e-12)))):
             status = prepare_dense(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
                                    cw, rg)
         if status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)):
