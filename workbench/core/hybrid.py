@@ -40,10 +40,9 @@ import numpy as np
 
 from .config import (ACCUM_GAP_TOL, ACCUM_TIME_S, CLOSED_RATE, EVENT_TIME_TOL, FLOOD_EVENTS,
                      FLOOD_WINDOW_S, GAP_TOL, GRAZE_BRACKET, GRAZE_ITERS, GRAZE_MARGIN, JIT,
-                     JIT_INLINE, LAMBDA_EPS, MAX_EVENTS_PER_STEP, RATE_EPS, STEP_REMAINDER_REL,
-                     STEPPED_TIME_S)
+                     JIT_INLINE, MAX_EVENTS_PER_STEP, STEP_REMAINDER_REL, STEPPED_TIME_S)
 from . import layout as ly
-from .constrained import project, rhs_regime, stick_margin, stick_tolerance, tangent_point
+from .constrained import project, rhs_regime
 from .contact import fill_geometry, in_set, regime_of, row_convective, row_rate
 from .dynamics import rhs
 from .integrate import rk_step

@@ -104,7 +104,6 @@ def missing(plan: dict) -> list[str]:
 
 def _compile(name: str, signature) -> None:
     import importlib
-    import numba
     module, function = name.rsplit(".", 1)
     kernel = getattr(importlib.import_module(f"workbench.core.{module}"), function)
     kernel.compile(tuple(eval_type(t) for t in signature))
