@@ -37,11 +37,12 @@ from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EV
                      STEPPED_TIME_S)
 from . import layout as ly
 from .constrained import rhs_regime
-from .contact import in_set, regime_of
+from .contact import regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
 from .event_functions import event_values
-from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _penetration, _stepped,
-                     _trial, apply_event, begin, flooding, locate, passed_before, store)
+from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _stepped, _trial,
+                     apply_event, begin, flooding, locate, passed_before, penetration, step_end,
+                     store)
 from .pair import dense, pair_step, prepare_dense
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
@@ -404,9 +405,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
                 t = t + theta * h_try
             else:
                 t = t_stop if h_try == t_stop - t else t + h_try
-            for p in range(ly.N_POINTS):       # penetration when the event is found
-                if not in_set(int(rg[ly.RG_SET]), p):
-                    _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t, 10 + p)
+            penetration(st, rg, ev, ly.EV_HI, t, 10)    # when the event is found
             n_step_events = 0
             while e >= 0:
                 n_step_events += 1
@@ -431,11 +430,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             err_prev = max(err, ERR_PREV_START)
         rejected = False
         h = max(h, h_floor)
-        for p in range(ly.N_POINTS):
-            if not in_set(int(rg[ly.RG_SET]), p):
-                _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p], t, 20 + p)
-        st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
-        st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
+        step_end(t, y, rg, ev, st)
     st[ly.ST_T] = t
     st[ly.ST_STEP] = m_stop
     ctl[ly.CTL_H_NEXT] = h

@@ -383,12 +383,25 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
 
 
 @nb.njit(**JIT_INLINE)
-def _penetration(st, depth, t, where):
-    """Keep the largest penetration depth (cm), its time and where it was found."""
-    if depth > st[ly.ST_MAX_PEN]:
-        st[ly.ST_MAX_PEN] = depth
-        st[ly.ST_T_MAX_PEN] = t
-        st[ly.ST_PEN_WHERE] = where
+def penetration(st, rg, ev, row, t, where):
+    """Keep the largest penetration depth (cm) of the open points' gaps in ev[row], its time
+    and where it was found (``where`` + the point: 10 at an event, 20 at a step's end)."""
+    for p in range(ly.N_POINTS):
+        if not in_set(int(rg[ly.RG_SET]), p):
+            depth = rg[ly.RG_ARM + p] - ev[row, ly.EV_GAP + p]
+            if depth > st[ly.ST_MAX_PEN]:
+                st[ly.ST_MAX_PEN] = depth
+                st[ly.ST_T_MAX_PEN] = t
+                st[ly.ST_PEN_WHERE] = where + p
+
+
+@nb.njit(**JIT_INLINE)
+def step_end(t, y, rg, ev, st):
+    """A step's end at t (s): the open gaps' penetration, the slide's range, the time reached."""
+    penetration(st, rg, ev, ly.EV_START, t, 20)
+    st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
+    st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
+    st[ly.ST_T] = t
 
 
 @nb.njit(**JIT_INLINE)
@@ -650,10 +663,7 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
                 break
             _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
             t = t_end if theta >= 1.0 else t + theta * h
-            for p in range(ly.N_POINTS):       # penetration when the event is found
-                if not in_set(int(rg[ly.RG_SET]), p):
-                    _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_HI, ly.EV_GAP + p], t,
-                                 10 + p)
+            penetration(st, rg, ev, ly.EV_HI, t, 10)    # when the event is found
         while e >= 0:
             n_step_events += 1
             if flooding(st, t) or n_step_events > MAX_EVENTS_PER_STEP:
@@ -676,12 +686,7 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
                 return status, t, n_log, stepped_left
             n_log += 1
             e = _immediate_impact(ev)
-    for p in range(ly.N_POINTS):
-        if not in_set(int(rg[ly.RG_SET]), p):
-            _penetration(st, rg[ly.RG_ARM + p] - ev[ly.EV_START, ly.EV_GAP + p], t, 20 + p)
-    st[ly.ST_S_MIN] = min(st[ly.ST_S_MIN], y[ly.S])
-    st[ly.ST_S_MAX] = max(st[ly.ST_S_MAX], y[ly.S])
-    st[ly.ST_T] = t
+    step_end(t, y, rg, ev, st)
     return ly.OK, t, n_log, stepped_left
 
 
