@@ -114,6 +114,7 @@ ERR_EVENT_FLOOD = 4
 ERR_NO_IMPACT_CANDIDATE = 5
 ERR_NO_REGIME = 6
 LOG_FULL = 7     # not an error: the event log is full, call again to continue
+STOPPED = 8      # not a kernel's: simulate(stop=...) ended the run early, as asked
 
 MESSAGES = {
     OK: "finished",
@@ -125,6 +126,7 @@ MESSAGES = {
     ERR_NO_REGIME: "no consistent regime after a transition (every candidate violated "
                    "a force or friction condition)",
     LOG_FULL: "the event log is full (the run continues in a new chunk)",
+    STOPPED: "stopped early by the caller's condition",
 }
 
 # --- status codes of the static equilibrium (workbench.core.equilibrium) -------

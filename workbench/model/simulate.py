@@ -234,6 +234,11 @@ class Run:
         return self.status == ly.OK
 
     @property
+    def stopped(self) -> bool:
+        """Ended early by the ``stop`` condition given to :func:`simulate`."""
+        return self.status == ly.STOPPED
+
+    @property
     def t_end(self) -> float:
         """The time reached (s): t0 + duration unless the run stopped early."""
         return float(self.stats["t_reached"])
@@ -403,7 +408,7 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
              free_decay_cm: float | None = None, fixed=(), progress: bool = False,
              t0: float = 0.0, regime: int = 0, method: str | None = None,
              tol: float | None = None, level_max: int = DEFAULT_LEVEL_MAX,
-             check_accuracy: bool = False) -> Run:
+             check_accuracy: bool = False, stop=None) -> Run:
     """Simulate ``duration`` seconds of the loose-joint beam (docs/model.md §3-9).
 
     ``excitation`` is an array from :mod:`workbench.model.drives` (default: none).
@@ -421,9 +426,13 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     PULSE_SAMPLES samples a pulse (the next rate dividing 1 / dt).  ``fixed`` holds coordinates (tests, locked
     joint).  ``check_accuracy`` runs a companion at finer settings (a tenth of
     the tolerance and half the coarsest step, or a quarter of a fixed step) and adds the run's error measured
-    against it to ``run.control`` (:mod:`workbench.model.accuracy`).  Never
-    raises on a failure of the integration: the run stops with a status code
-    and keeps what it computed.
+    against it to ``run.control`` (:mod:`workbench.model.accuracy`).  ``stop``: a
+    callable given the record so far (a :class:`Run` of the samples whose filtered
+    channels are final, so its values are those of the whole run's first part) after
+    each simulated second; when it returns a reason (a string), the run ends there with
+    status ``STOPPED`` and that reason as its message (the leveling search stops a run
+    once a limit is exceeded).  Never raises on a failure of the integration: the run
+    stops with a status code and keeps what it computed.
     """
     if not isinstance(params, Parameters):
         raise ParameterError(f"params must be workbench.model.params.Parameters, got {type(params).__name__}")
@@ -515,6 +524,12 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
             break
         done = new_done
         status = ly.OK
+        if stop is not None and done < n_steps:
+            reason = stop(_record_so_far(params, ex, dt, duration, parts_t, parts_y, parts_s,
+                                         parts_analog, parts_log, st, static_tip, label, t0))
+            if reason:
+                status = ly.STOPPED
+                break
     parts_analog.append(decimator.finish())
     parts_s = [np.concatenate(parts_s)]
     parts_s[0][:, antialias.ANALOG_COLUMNS] = np.concatenate(parts_analog)
@@ -523,6 +538,8 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
         bar.close()
     run = _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log,
                     st, static_tip, label, t0)
+    if status == ly.STOPPED:
+        run.message = f"{ly.MESSAGES[status]}: {reason}"
     run.compile_s = compile_s
     run.anti_alias = antialias.summary(m, 1.0 / (k * dt))
     run.method = method
@@ -716,6 +733,17 @@ def compile_kernel(kernel, args) -> float:
     t = time.perf_counter()
     kernel.compile(tuple(numba.typeof(a) for a in args))
     return time.perf_counter() - t
+
+
+def _record_so_far(params, ex, dt, duration, parts_t, parts_y, parts_s, parts_analog, parts_log,
+                   st, static_tip, label, t0) -> Run:
+    """The samples so far whose filtered channels are final, as a Run (status OK)."""
+    analog = np.concatenate(parts_analog)
+    n = len(analog)
+    sig = np.concatenate(parts_s)[:n]
+    sig[:, antialias.ANALOG_COLUMNS] = analog
+    return _assemble(params, ex, dt, duration, ly.OK, 0.0, [np.concatenate(parts_t)[:n]],
+                     [np.concatenate(parts_y)[:n]], [sig], parts_log, st, static_tip, label, t0)
 
 
 def _assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, parts_log, st,

@@ -48,6 +48,8 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     if has == {"gap_mm", "freq_hz"}:
         figs["frf_map_tip"] = lambda: F.frf_maps(table)
         figs["frf_map_strain1"] = lambda: F.frf_maps(table, "strain1_rms")
+        if "force_n_used" in table:
+            figs["force_map"] = lambda: F.frf_maps(table, "force_n_used")
         figs["response_curves"] = lambda: F.response_curves(table)
     if sine:
         figs["regime_shares"] = lambda: F.regime_shares(table)
@@ -233,17 +235,21 @@ def measured_sentence(ok: pd.DataFrame) -> str:
 
 
 def range_lines(table: pd.DataFrame) -> list[str]:
-    """Every finished point whose response left the range the model is validated for
-    (``metrics.validity``: the tip beyond the paper's 8.4 cm, the slide beyond the slot's
-    travel, an accelerometer or the force transducer beyond its range)."""
+    """How many finished points stayed within the range the model is validated for, and every
+    one that did not (``metrics.validity``: the tip beyond the paper's 8.4 cm, the slide beyond
+    the slot's travel, an accelerometer or the force transducer beyond its range)."""
     if "out_of_range" not in table:
         return []
-    over = table[(table.status == "ok") & (table.out_of_range.fillna("") != "")]
+    ok = table[table.status == "ok"]
+    over = ok[ok.out_of_range.fillna("") != ""]
+    count = (f"{len(ok) - len(over)} of {len(ok)} points lie inside the validated range (tip "
+             "within 8.4 cm of its static position, the slide within the slot's travel, the "
+             "sensors within their ranges")
     if not len(over):
-        return ["Every point stayed within the validated range (tip within 8.4 cm of its "
-                "static position, the slide within the slot's travel, the sensors within "
-                "their ranges).", ""]
+        return [count + ").", ""]
+    kinds = pd.Series([k for v in over.out_of_range for k in v.split(",")]).value_counts()
     lines = ["## Points outside the validated range", "",
+             count + f"; outside: {', '.join(f'{k} at {n}' for k, n in kinds.items())}).", "",
              "The tip beyond the paper's 8.4 cm (§5.3; the beams' small-slope shapes were "
              "compared with the rig up to there), the slide beyond the slot's travel (the "
              "end stop, an ASSUMPTION, carries it), or a sensor beyond its range (50 g, "
@@ -254,6 +260,42 @@ def range_lines(table: pd.DataFrame) -> list[str]:
               f"{r.slide_abs_max_cm:.3g} | {r.accel_abs_max_g:.3g} | {r.force1_abs_max_n:.3g} |"
               for _, r in over.iterrows()]
     return lines + [""]
+
+
+def level_lines(study, table: pd.DataFrame) -> list[str]:
+    """A levelled study's rule, the forces it found and which limit decided them, and every
+    point whose limits no force met (with its largest responses)."""
+    if study.limits is None or "force_n_used" not in table:
+        return []
+    lim = study.limits
+    ok = table[table.status == "ok"]
+    named = [f"accelerometers {lim.accel_g:g} g" if lim.accel_g else "",
+             f"force transducer {lim.force_transducer_n:g} N" if lim.force_transducer_n else "",
+             f"tip {lim.tip_cm:g} cm" if lim.tip_cm else "",
+             "the slide within the slot's travel" if lim.slot else ""]
+    lines = ["## Each point's force", "",
+             f"Each point's force is the largest, up to {study.excitation['force_n']:g} N, at "
+             f"which every limit holds over the whole run ({', '.join(n for n in named if n)}), "
+             f"found within a factor {lim.resolution:g} by a bracket search "
+             "(`workbench/study/leveling.py`; the map `force_map` shows it)."]
+    if len(ok):
+        decided = ok.level_limit.value_counts()
+        lines[-1] += (f" Forces {ok.force_n_used.min():.3g}-{ok.force_n_used.max():.3g} N "
+                      f"(median {ok.force_n_used.median():.3g} N); decided by "
+                      + ", ".join(f"{k} at {n}" for k, n in decided.items())
+                      + f"; {ok.level_runs.mean():.2g} runs a point on average "
+                      f"({int(ok.level_runs.sum())} in all).")
+    unmet = ok[~ok.level_met.astype(bool)]
+    lines.append("")
+    if len(unmet):
+        lines += [f"{len(unmet)} points meet the limits at no force tried:", "",
+                  "| point | lowest force (N) | runs | limit | tip max (cm) | slide max (cm) | "
+                  "accel max (g) |", "|---|---|---|---|---|---|---|"]
+        lines += [f"| {point_title(r)} | {r.force_n_used:.3g} | {int(r.level_runs)} | "
+                  f"{r.level_limit} | {r.tip_abs_max_cm:.3g} | {r.slide_abs_max_cm:.3g} | "
+                  f"{r.accel_abs_max_g:.3g} |" for _, r in unmet.iterrows()]
+        lines.append("")
+    return lines
 
 
 def render_index(study, table, figures, tables, out) -> str:
@@ -273,6 +315,7 @@ def render_index(study, table, figures, tables, out) -> str:
                   f"{r.message} |" for _, r in failed.iterrows()]
         lines.append("")
     lines += accuracy_lines(study, table)
+    lines += level_lines(study, table)
     lines += range_lines(table)
     lines += ["## Tables", ""]
     for p in tables:

@@ -13,8 +13,6 @@
     check_accuracy = true            # optional: each point also run at a tenth of tol and half
                                      # the step (a quarter of a fixed dt), its error measured
                                      # against that companion (model/accuracy.py)
-    tip_limit_cm = 5.0               # optional: a response-limited drive, each point's force the
-                                     # largest up to force_n keeping the tip within it (leveling.py)
     save_series = [{gap_mm = 1.016, freq_hz = 20.0}]   # optional: points whose time series are kept
                                      # (each selector names axis values; {} selects every point)
 
@@ -22,6 +20,16 @@
     drive = "sine"                   # a drive of model/drives.py: sine, chirp, free_decay, hammer_joint, hammer_tip, none
     force_n = 20.0
     ramp_s = 1.0                     # soft start (s)
+
+    [limits]                         # optional: a response-limited drive (study/leveling.py): each
+                                     # point's force the largest, up to force_n, keeping every
+                                     # limit; each key optional (default), false switches one off
+    accel_g = 50.0                   # accelerometers' range (g; PCB 352A24 datasheet)
+    force_transducer_n = 2224.0      # force transducer's range (N; PCB 208C03 datasheet)
+    tip_cm = 8.4                     # tip deflection (cm; seed §5.3)
+    slot = true                      # the slide within the slot's travel (s_travel)
+    resolution = 1.25                # the force found within this factor of the largest
+    max_runs = 10                    # runs a point may take
 
     [fixed]                          # any model parameter (workbench params), unit suffixes allowed
     mu_s = 0.3
@@ -34,6 +42,11 @@
 Every key is checked before anything runs (:func:`load`), and every grid
 point's model parameters and excitation are built once, so a bad value is
 reported with the parameter's allowed range, not halfway through a sweep.
+
+A study with ``[limits]`` over a sine's frequency axis levels each chain of
+frequencies (all other axes equal) in order, each point's search starting
+from the force its lower neighbour used; only the force carries over, not
+the state.
 
 A ``[sample]`` table with ``[ranges]`` instead of ``[axes]`` draws the points
 from a Saltelli design for a global sensitivity study
@@ -56,12 +69,14 @@ import numpy as np
 
 from ..model import drives
 from . import sensitivity
+from .leveling import Limits
 from ..model.limits import MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 SWEEP_MODES = ("independent", "up", "down", "up-down")
 STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz", "tol",
-              "method", "tip_limit_cm", "save_series", "initial", "check_accuracy"}
+              "method", "save_series", "initial", "check_accuracy"}
+LIMIT_KEYS = {"accel_g": "g", "force_transducer_n": "N", "tip_cm": "cm"}
 
 
 class StudyError(ParameterError):
@@ -113,7 +128,7 @@ class Study:
     source: str = ""
     method: str = "dop853"
     tol: float | None = None
-    tip_limit_cm: float | None = None
+    limits: Limits | None = None
     check_accuracy: bool = False
     sample: sensitivity.Sample | None = None
     points: tuple = field(default=(), repr=False)
@@ -129,6 +144,12 @@ class Study:
         for p in self.points:
             groups.setdefault(p.chain, []).append(p)
         return [sorted(g, key=lambda p: p.step) for g in groups.values()]
+
+    @property
+    def chained(self) -> bool:
+        """Whether a point depends on the one before it in its chain (a stepped sweep's state,
+        or a levelled chain's first estimate of the force)."""
+        return any(p.step > 0 for p in self.points)
 
     def saves_series(self, point: Point) -> bool:
         return any(all(_same(point.values.get(k, point.excitation.get(k)), v)
@@ -156,11 +177,11 @@ def load(path: str | Path) -> Study:
 
 def from_dict(data: dict[str, Any], source: str = "") -> Study:
     """A Study from the parsed TOML tables (see the module docstring)."""
-    tables = ("study", "excitation", "fixed", "axes", "sample", "ranges")
+    tables = ("study", "excitation", "limits", "fixed", "axes", "sample", "ranges")
     unknown = sorted(set(data) - set(tables))
     if unknown:
-        raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [fixed], "
-                         "[axes], or [sample] with [ranges]")
+        raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [limits], "
+                         "[fixed], [axes], or [sample] with [ranges]")
     for table in tables:
         if table in data and not isinstance(data[table], dict):
             raise StudyError(f"[{table}] must be a table of keys, got {_short(data[table])}")
@@ -198,9 +219,6 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     if abs(duration * output_hz - round(duration * output_hz)) > 1e-9 * duration * output_hz:
         raise StudyError(f"[study] duration_s = {duration} s must be a whole number of samples "
                          f"at output_hz = {output_hz} Hz (the last sample is the final state)")
-    tip_limit = head.get("tip_limit_cm")
-    if tip_limit is not None:
-        tip_limit = check_positive("[study] tip_limit_cm", tip_limit, "cm")
     check_accuracy = head.get("check_accuracy", False)
     if not isinstance(check_accuracy, bool):
         raise StudyError(f"[study] check_accuracy = {_short(check_accuracy)} must be true or false")
@@ -266,9 +284,10 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                      if drives.DRIVES[drive].default(k) is None)
     if missing:
         raise StudyError(f"a {drive!r} excitation needs {missing} in [excitation] or [axes]")
-    if tip_limit is not None and "force_n" not in drives.DRIVES[drive].keys:
-        raise StudyError(f"[study] tip_limit_cm sets each point's force: a {drive!r} excitation "
-                         "has no force_n")
+    limits = _limits(data["limits"]) if "limits" in data else None
+    if limits is not None and "force_n" not in drives.DRIVES[drive].keys:
+        raise StudyError(f"[limits] sets each point's force: a {drive!r} excitation has no "
+                         "force_n")
     frequency = drives.DRIVES[drive].frequency_key
     if sweep != "independent" and (frequency is None or frequency not in axes):
         raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a drive "
@@ -302,6 +321,8 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         points.append(pt)
     if sweep != "independent":
         points = _frequency_chains(points, sweep)
+    elif limits is not None and frequency is not None and frequency in axes:
+        points = _frequency_chains(points, "up", direction="")
     else:
         points = [Point(p.values, p.params, p.excitation, chain=i) for i, p in enumerate(points)]
     raw = head.get("save_series", [])
@@ -317,7 +338,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                  window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
                  excitation={"drive": drive, **exc}, fixed=fixed, axes=axes, save_series=series,
                  source=source, points=tuple(points), method=method, tol=tol,
-                 tip_limit_cm=tip_limit, check_accuracy=check_accuracy, sample=sample)
+                 limits=limits, check_accuracy=check_accuracy, sample=sample)
 
 
 def _combinations(axes: dict, sample) -> list[tuple[dict, dict]]:
@@ -372,8 +393,38 @@ def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     check_settings(point.params, ex, duration, dt, output_hz, names=where)
 
 
-def _frequency_chains(points, sweep):
-    """Chains of equal non-frequency values, ordered by frequency (up, down or both)."""
+def _limits(table: dict) -> Limits:
+    """The ``[limits]`` table as :class:`~workbench.study.leveling.Limits` (one-line errors)."""
+    bad = sorted(set(table) - set(LIMIT_KEYS) - {"slot", "resolution", "max_runs"})
+    if bad:
+        raise StudyError(f"unknown key(s) {bad} in [limits]; allowed: "
+                         f"{sorted([*LIMIT_KEYS, 'slot', 'resolution', 'max_runs'])}")
+    values = {}
+    for key, unit in LIMIT_KEYS.items():
+        if key in table:
+            value = table[key]
+            values[key] = None if value is False else check_positive(f"[limits] {key}", value, unit)
+    if "slot" in table:
+        if not isinstance(table["slot"], bool):
+            raise StudyError(f"[limits] slot = {_short(table['slot'])} must be true or false")
+        values["slot"] = table["slot"]
+    if "resolution" in table:
+        r = table["resolution"]
+        if isinstance(r, bool) or not isinstance(r, (int, float)) or not 1.01 <= r <= 4.0:
+            raise StudyError(f"[limits] resolution = {_short(r)} must be a number in [1.01, 4] "
+                             "(the largest force is found within this factor)")
+        values["resolution"] = float(r)
+    if "max_runs" in table:
+        n = table["max_runs"]
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 50:
+            raise StudyError(f"[limits] max_runs = {_short(n)} must be a whole number in [1, 50]")
+        values["max_runs"] = n
+    return Limits(**values)
+
+
+def _frequency_chains(points, sweep, direction=None):
+    """Chains of equal non-frequency values, ordered by frequency (up, down or both); the
+    points' ``direction`` is the sweep's, or ``direction`` if given."""
     chains: dict[tuple, list[Point]] = {}
     for p in points:
         key = tuple((k, repr(v)) for k, v in p.values.items() if k != "freq_hz")
@@ -384,7 +435,7 @@ def _frequency_chains(points, sweep):
         order = {"up": [(p, "up") for p in up],
                  "down": [(p, "down") for p in reversed(up)],
                  "up-down": [(p, "up") for p in up] + [(p, "down") for p in reversed(up[:-1])]}[sweep]
-        for step, (p, direction) in enumerate(order):
+        for step, (p, way) in enumerate(order):
             out.append(Point(p.values, p.params, p.excitation, chain=c, step=step,
-                             direction=direction))
+                             direction=way if direction is None else direction))
     return out

@@ -63,7 +63,7 @@ QUANTITIES = {
     "tip_rms": "tip RMS (cm)", "tip_h1": "tip at f (cm)", "strain1_rms": "strain1 RMS (-)",
     "accel3_rms": "accel3 RMS (cm/s²)", "impacts_per_s": "impacts per s",
     "switches_per_s": "switches per s", "stick_share": "stick share",
-    "share_0": "free-flight share",
+    "share_0": "free-flight share", "force_n_used": "drive force used (N)",
 }
 #: Resolution (Hz) of the spectrum the subharmonic's level is read from.
 SUB_RESOLUTION_HZ = 0.5

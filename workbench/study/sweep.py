@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from ..core import layout as ly
-from .leveling import limited_run
+from .leveling import level
 from .metrics import contact_checks, point_metrics
 from .provenance import code_version
 from ..model.drives import excitation_array
@@ -59,7 +59,8 @@ def point_key(study: Study, point: Point, previous_key: str = "") -> str:
         "first_in_chain": point.step == 0, "duration_s": study.duration_s,
         "window_s": study.window_s, "dt": study.dt, "output_hz": study.output_hz,
         "method": study.method, "tol": study.tol, "initial": study.initial, "previous": previous_key, "code": code_version(),
-        "tip_limit_cm": study.tip_limit_cm, "check_accuracy": study.check_accuracy,
+        "limits": study.limits.to_dict() if study.limits else None,
+        "check_accuracy": study.check_accuracy,
     }
     text = json.dumps(record, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -68,7 +69,7 @@ def point_key(study: Study, point: Point, previous_key: str = "") -> str:
 def chain_keys(study: Study, chain: list[Point]) -> list[str]:
     keys, prev = [], ""
     for p in chain:
-        prev = point_key(study, p, prev if study.sweep != "independent" else "")
+        prev = point_key(study, p, prev if study.chained else "")
         keys.append(prev)
     return keys
 
@@ -98,28 +99,33 @@ def _row(point, key, status, message, wall, metrics, run=None, continued=False):
     return row
 
 
-def run_point(study: Study, point: Point, key: str, out: Path, initial=None) -> dict:
-    """Simulate one point, write its row (and series), return the row."""
+def run_point(study: Study, point: Point, key: str, out: Path, initial=None,
+              force_estimate: float | None = None) -> dict:
+    """Simulate one point, write its row (and series), return the row.
+
+    ``force_estimate`` (N): a levelled study's first force to try (the chain's previous
+    point's), else its ``force_n``."""
     t0 = time.perf_counter()
     continued = initial is not None
     try:
-        def simulate_at(force_n=None, check_accuracy=False):
+        def simulate_at(force_n=None, check_accuracy=False, stop=None):
             settings = point.excitation if force_n is None else {**point.excitation,
                                                                   "force_n": force_n}
             return simulate(point.params, excitation_array(settings, first_in_chain=not continued),
                             study.duration_s, dt=study.dt, output_hz=study.output_hz,
                             method=study.method, tol=study.tol, check_accuracy=check_accuracy,
-                            initial=initial if continued else study.initial, **point.start_keywords)
-        if study.tip_limit_cm is None:
+                            initial=initial if continued else study.initial, stop=stop,
+                            **point.start_keywords)
+        if study.limits is None:
             run = simulate_at(check_accuracy=study.check_accuracy)
-            level = {}
+            levelled = {}
         else:
-            run, force, runs, met = limited_run(simulate_at, point.excitation["force_n"],
-                                                study.tip_limit_cm)
-            level = {"force_n_used": force, "level_runs": runs, "level_met": met}
+            found = level(simulate_at, point.excitation["force_n"], study.limits, force_estimate)
+            run, levelled = found.run, found.row()
             if study.check_accuracy and run.ok:      # the same run again, with its companion
-                run = simulate_at(force, check_accuracy=True)
-        metrics = {**level, **point_metrics(run, study.window_s, point.drive_hz)} if run.ok else level
+                run = simulate_at(found.force_n, check_accuracy=True)
+        metrics = ({**levelled, **point_metrics(run, study.window_s, point.drive_hz)}
+                   if run.ok else levelled)
         row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)
         if study.saves_series(point):
@@ -144,17 +150,20 @@ def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path,
     if sweep_pid is not None and sweep_pid != os.getpid():
         _watch(sweep_pid)
     rows = []
-    state = None
+    state = estimate = None
     for point, key in zip(chain, keys):
         found = read_point(out / "points" / f"{key}.parquet")
         if found is not None:
             row = found.iloc[0].to_dict()
         else:
-            row = run_point(study, point, key, out, initial=state)
+            row = run_point(study, point, key, out, initial=state, force_estimate=estimate)
         rows.append(row)
-        state = None
-        if study.sweep != "independent" and row.get("status") == "ok":
-            state = np.array([row[c] for c in STATE_COLUMNS])
+        state = estimate = None
+        if row.get("status") == "ok":
+            if study.sweep != "independent":
+                state = np.array([row[c] for c in STATE_COLUMNS])
+            if study.limits is not None and row.get("level_met"):
+                estimate = float(row["force_n_used"])
     return rows
 
 
