@@ -22,19 +22,28 @@ S_TRAVEL = Parameters().s_travel
 
 def _fake(responses, ok=True):
     """simulate_at for a structure whose largest responses at a force F (N) are
-    ``responses(F)``: a dict of any of tip (cm), slide (cm), accel (g), force1 (N)."""
+    ``responses(F)``: a dict of any of tip (cm), slide (cm), accel (g), force1 (N) reached
+    within the first 4 s, and optionally under "late" those reached by the end (10 s)."""
     calls = []
 
-    def simulate_at(force, stop=None):
-        calls.append(force)
-        r = {"tip": 0.0, "slide": 0.0, "accel": 0.0, "force1": force, **responses(force)}
+    def record(force, r, seconds):
+        r = {"tip": 0.0, "slide": 0.0, "accel": 0.0, "force1": force, **r}
         sig = pd.DataFrame({"tip_y": [5.0, 5.0 + r["tip"]], "s": [0.0, -r["slide"]],
                             "accel1": [0.0, r["accel"] * G_CM_S2], "accel2": [0.0, 0.0],
                             "accel3": [0.0, 0.0], "force1": [0.0, r["force1"] * N_DYN]},
-                           index=[0.0, 1.0])
-        run = SimpleNamespace(ok=ok, stopped=False, signals=sig, static_tip_y=5.0,
-                              params=Parameters(), force=force)
-        if ok and stop is not None and stop(run):         # as simulate: ended at the excess
+                           index=[0.0, seconds])
+        return SimpleNamespace(ok=ok, stopped=False, signals=sig, static_tip_y=5.0,
+                               params=Parameters(), force=force, simulated_s=seconds)
+
+    def simulate_at(force, stop=None):
+        calls.append(force)
+        early = {k: v for k, v in responses(force).items() if k != "late"}
+        run = record(force, early, 4.0)
+        if ok and stop is not None and stop(run):          # as simulate: ended there
+            run.ok, run.stopped = False, True
+            return run
+        run = record(force, {**early, **responses(force).get("late", {})}, 10.0)
+        if ok and stop is not None and stop(run):
             run.ok, run.stopped = False, True
         return run
     return simulate_at, calls
@@ -77,12 +86,24 @@ def test_a_good_estimate_needs_few_runs_and_a_point_within_limits_runs_once():
     simulate_at, calls = _fake(_ratchet(37.0))
     found = level(simulate_at, 200.0, Limits(), estimate=35.0)
     _bracketed(found, 37.0)
-    assert calls == [35.0, 35.0 * 1.25]                # up one resolution step: bracketed
+    assert calls == [35.0, 35.0 * 1.25, 35.0]          # trial, up one step: bracketed; whole
     simulate_at, calls = _fake(lambda f: {"tip": 0.001 * f})
     found = level(simulate_at, 200.0, Limits(), estimate=150.0)
     assert (found.met, found.limit, calls[-1]) == (True, "force_n", 200.0)
     simulate_at, calls = _fake(lambda f: {})
-    assert level(simulate_at, 200.0, Limits()).runs == 1 and calls == [200.0]
+    assert level(simulate_at, 200.0, Limits()).runs == 2 and calls == [200.0, 200.0]
+
+
+def test_a_limit_exceeded_only_after_the_trial_moves_the_bracket_down():
+    """A slow ratchet: above 37 N the slide reaches the end stop within the trial, between 30
+    and 37 N only later; the kept force's whole run meets the limits."""
+    def responses(f):
+        slow = {"late": {"slide": S_TRAVEL + 0.005}} if f > 30.0 else {}
+        return {**_ratchet(37.0)(f), **slow}
+    simulate_at, calls = _fake(responses)
+    found = level(simulate_at, 200.0, Limits(max_runs=30))
+    _bracketed(found, 30.0)
+    assert found.run.ok and found.run.simulated_s == 10.0 and found.limit == "slot"
 
 
 def test_a_point_that_no_force_keeps_within_the_limits_is_reported_not_hidden():
@@ -217,3 +238,16 @@ def test_a_run_stopped_at_a_limit_is_the_whole_runs_first_part():
     np.testing.assert_array_equal(part.signals[cols].iloc[:n].to_numpy(),
                                   whole.signals[cols].iloc[:n].to_numpy())
     assert validity(part)["tip_abs_max_cm"] > 1.0
+
+
+def test_the_documented_limits_are_the_defaults():
+    """docs/usage.md's [limits] example states every key at its default."""
+    import tomllib
+
+    from workbench.study.definition import _limits
+    text = (S.__file__.rsplit("/workbench/", 1)[0] + "/docs/usage.md")
+    block = open(text).read().split("```toml\n  [limits]", 1)[1].split("```", 1)[0]
+    table = tomllib.loads("[limits]" + "\n".join(line[2:] for line in block.splitlines()))
+    assert set(table["limits"]) == {"accel_g", "force_transducer_n", "tip_cm", "slot",
+                                    "resolution", "max_runs"}
+    assert _limits(table["limits"]) == Limits()
