@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from workbench.experiments import files as F
+from workbench.lab import files as F
 from workbench.present.comparison import compare
-from workbench.experiments.estimate import estimate
-from workbench.experiments.matching import setup_from
+from workbench.lab.estimate import estimate
+from workbench.lab.matching import setup_from
 
 HIDDEN = {"e_a": 5.5e11, "e_b": 6.2e11, "force_n": 14.0}
 START = {"e_a": 7.0e11, "e_b": 7.0e11, "force_n": 20.0}
@@ -76,7 +76,7 @@ def main() -> None:
         f"Two shaker records ({', '.join(f'{f:g} Hz' for f in RECORDS.values())}, {DURATION_S:g} s, "
         f"window after {SKIP_S:g} s) simulated with hidden parameters, {NOISE_REL:.0%} noise, written as "
         "LabVIEW files with the nominal settings; fitted from the nominal start by "
-        "`workbench.experiments.estimate.estimate` (features: log RMS and log band powers of strain1, strain2, "
+        "`workbench.lab.estimate.estimate` (features: log RMS and log band powers of strain1, strain2, "
         f"accel1-3 and contact shares; {args.jobs} worker processes).", "",
         table.to_markdown(index=False, floatfmt=".4g"), "",
         f"Stated tolerance: {TOLERANCE:.0%} on every value.  All within: "

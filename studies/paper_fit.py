@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from workbench.experiments.estimate import _apply, fit
+from workbench.lab.estimate import _apply, fit
 from workbench.present.observed import (SEARCH_MARGIN, SineObservations, band_misses, misses,
                                             paper_targets, residual)
 from workbench.identify.paper import APPENDIX_B_MEAN_E_GPA

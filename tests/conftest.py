@@ -33,8 +33,8 @@ def random_state(rng):
 #: (``--dist loadscope --no-loadscope-reorder``); these go first, so that no long module
 #: starts when the other worker is nearly done.
 LONG_MODULES = ("test_docs.py", "reference/test_reference_events.py", "study/test_sweep.py",
-                "study/test_sensitivity.py", "experiments/test_compare_estimate.py",
-                "experiments/test_frf.py")
+                "study/test_sensitivity.py", "lab/test_compare_estimate.py",
+                "lab/test_frf.py")
 
 
 def pytest_collection_modifyitems(session, config, items):

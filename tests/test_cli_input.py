@@ -20,7 +20,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 from workbench import cli
-from workbench.experiments import files as F
+from workbench.lab import files as F
 
 
 class WouldRun(BaseException):
@@ -34,13 +34,13 @@ def _stub(*args, **kwargs):
 @pytest.fixture(autouse=True)
 def no_work(monkeypatch, tmp_path):
     import workbench.present.comparison
-    import workbench.experiments.estimate
+    import workbench.lab.estimate
     import workbench.model.simulate
     import workbench.study.sweep
     monkeypatch.setattr(workbench.model.simulate, "simulate", _stub)
     monkeypatch.setattr(workbench.study.sweep, "run_study", _stub)
-    monkeypatch.setattr(workbench.experiments.estimate, "estimate", _stub)
-    monkeypatch.setattr(workbench.experiments.estimate, "fit", _stub)
+    monkeypatch.setattr(workbench.lab.estimate, "estimate", _stub)
+    monkeypatch.setattr(workbench.lab.estimate, "fit", _stub)
     monkeypatch.setattr(workbench.present.comparison, "compare", _stub)
     monkeypatch.setenv("WORKBENCH_CRASH_DIR", str(tmp_path / "crash"))
     monkeypatch.chdir(tmp_path)

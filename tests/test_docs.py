@@ -22,7 +22,7 @@ import pandas as pd
 import pytest
 
 from workbench import cli
-from workbench.experiments import files as F
+from workbench.lab import files as F
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]

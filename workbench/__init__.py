@@ -18,7 +18,7 @@ The API a user calls (docs/usage.md)::
 
 Everything else stays reachable in the sub-packages (``workbench.core``
 the kernels, ``workbench.model``, ``workbench.study``,
-``workbench.experiments``, ``workbench.identify``, ``workbench.present``).
+``workbench.lab``, ``workbench.identify``, ``workbench.present``).
 The names are imported on first use, so ``import workbench`` stays light.
 """
 from importlib import import_module
@@ -38,10 +38,10 @@ _API = {
     "hammer_joint": ("model.drives", "hammer_joint"),
     "hammer_tip": ("model.drives", "hammer_tip"),
     "load_study": ("study.definition", "load"), "sweep": ("study.sweep", "sweep"),
-    "read": ("experiments.files", "read"), "write": ("experiments.files", "write"),
-    "convert": ("experiments.files", "convert"),
-    "record_from_run": ("experiments.files", "record_from_run"),
-    "frf": ("experiments.frf", "frf"), "compare": ("present.comparison", "compare"),
+    "read": ("lab.files", "read"), "write": ("lab.files", "write"),
+    "convert": ("lab.files", "convert"),
+    "record_from_run": ("lab.files", "record_from_run"),
+    "frf": ("lab.frf", "frf"), "compare": ("present.comparison", "compare"),
 }
 
 __all__ = ["CORK_MODELS", "ParameterError", "Parameters", "__version__", *_API]

@@ -13,7 +13,7 @@ import pytest
 
 from workbench.core import excitation as cx
 from workbench.core.contact import regime_of as kernel_regime_of
-from workbench.experiments.matching import setup_from
+from workbench.lab.matching import setup_from
 from workbench.model import drives, regimes
 from workbench.model.params import ParameterError
 from workbench.reference.events import Regime

@@ -8,8 +8,8 @@ import pandas as pd
 import pytest
 
 from workbench.core import layout as ly
-from workbench.experiments.estimate import fit
-from workbench.experiments.matching import Setup
+from workbench.lab.estimate import fit
+from workbench.lab.matching import Setup
 from workbench.present.observed import (SEARCH_MARGIN, SineObservations, band_misses,
                                             misses, residual)
 from workbench.model.params import Parameters

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from workbench.model.params import Parameters
-from workbench.present.report import range_lines
+from workbench.present.point_checks import range_lines
 from workbench.study import definition as S
 from workbench.study import sweep as W
 from workbench.study.leveling import MIN_FORCE_FRACTION, Limits, level

@@ -421,7 +421,7 @@ def test_the_code_version_covers_the_kernels_and_the_model_not_the_presentation(
     for computing in ("core/hybrid.py", "core/config.py", "model/simulate.py", "model/params.py",
                       "study/sweep.py", "study/metrics.py"):
         assert computing in names
-    for presenting in ("present/figures.py", "experiments/files.py", "cli.py"):
+    for presenting in ("present/figures.py", "lab/files.py", "cli.py"):
         assert presenting not in names
 
 

@@ -286,7 +286,7 @@ def strain_scale(args) -> dict[str, float]:
 
 
 def read_record(args, path):
-    from ..experiments import files
+    from ..lab import files
     return files.read(path, strain_scale(args), files.format_of(path, args.format))
 
 
@@ -312,7 +312,7 @@ def add_jobs_option(parser, what: str) -> None:
 
 
 def add_format_option(parser, option="--format", dest="format", what="the file's format") -> None:
-    from ..experiments.files import FORMATS
+    from ..lab.files import FORMATS
     parser.add_argument(option, dest=dest, choices=tuple(FORMATS),
                         help=f"{what} (default: by its suffix)")
 

@@ -15,7 +15,7 @@ from .common import (EXIT_NOT_CONVERGED, EXIT_OK, EXIT_RUN_FAILED, RESULTS, add_
 
 
 def _cmd_convert(args) -> int:
-    from ..experiments import files
+    from ..lab import files
     source_format = files.format_of(args.source, args.source_format, option="--from")
     target_format = files.format_of(args.target, args.target_format, option="--to")
     check_output_file("TARGET", args.target)
@@ -34,9 +34,9 @@ def _cmd_convert(args) -> int:
 def _cmd_compare(args) -> int:
     from ..present.comparison import compare
     from ..model import drives
-    from ..experiments.matching import setup_from
+    from ..lab.matching import setup_from
 
-    from ..experiments.compare import SIGNALS
+    from ..lab.compare import SIGNALS
     record = read_record(args, args.file)
     check_window(args.file, record, args.skip_s)
     if not any(c in record.columns for c in SIGNALS):
@@ -59,9 +59,9 @@ def _cmd_compare(args) -> int:
 
 
 def _cmd_frf(args) -> int:
-    from ..experiments.channels import reference_of
-    from ..experiments.formats import uff
-    from ..experiments.frf import (DEFAULT_SEGMENT_S, default_window, frf, magnitude_phase,
+    from ..lab.channels import reference_of
+    from ..lab.formats import uff
+    from ..lab.frf import (DEFAULT_SEGMENT_S, default_window, frf, magnitude_phase,
                                    peak_table as peak_table_of, responses_of)
     from ..present.figures import frf_figure, save
 
@@ -110,8 +110,8 @@ def _cmd_frf(args) -> int:
 
 
 def _cmd_estimate(args) -> int:
-    from ..experiments.estimate import FITTABLE, check_start, estimate, fit
-    from ..experiments.matching import setup_from
+    from ..lab.estimate import FITTABLE, check_start, estimate, fit
+    from ..lab.matching import setup_from
 
     start = pair_numbers(args.fit, "--fit", "START", 0, lo_open=True)
     unknown = sorted(set(start) - set(FITTABLE))
@@ -239,7 +239,7 @@ def add_parsers(sub) -> None:
                           "force_gain (a factor on every drive's force)")
     est.add_argument("--bounds", metavar="NAME=LO:HI", action="append", default=[],
                      help="the range searched for a fitted parameter (default: wide, "
-                          "workbench/experiments/estimate.py FITTABLE)")
+                          "workbench/lab/estimate.py FITTABLE)")
     est.add_argument("--paper", type=_paper_forces, metavar="SINE_N:CHIRP_N",
                      help="fit to the paper's §6 observations instead of files: switching "
                           "between 14 and 23 and the 10 Hz subharmonic on the 20 Hz sine at "

@@ -85,8 +85,8 @@ RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--outp
 
 
 def _cmd_run(args) -> int:
-    from ..experiments import files
-    from ..experiments.matching import settings_of
+    from ..lab import files
+    from ..lab.matching import settings_of
     from ..model import drives
     from ..model.methods import METHODS
     from ..model.simulate import check_method, check_settings, prepare_kernels, simulate

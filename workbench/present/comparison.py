@@ -1,6 +1,6 @@
 """``workbench compare FILE``: a record against the matching simulation, as figures and tables.
 
-The paper's comparisons (seed §6) of :mod:`workbench.experiments.compare`,
+The paper's comparisons (seed §6) of :mod:`workbench.lab.compare`,
 drawn and written into a folder: time-history overlay (Fig. 6), power
 spectra (Fig. 7-8), contact switching diagrams (Fig. 9-10), for chirps
 spectrograms of strain1 (Fig. 11-12) and the FRFs with their peaks; and
@@ -12,11 +12,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..experiments.channels import kind
-from ..experiments.compare import (DEFAULT_THRESHOLD_V, SIGNALS, Comparison, code_series,
+from ..lab.channels import kind
+from ..lab.compare import (DEFAULT_THRESHOLD_V, SIGNALS, Comparison, code_series,
                                    contact_differences, peak_shifts, signal_differences, window)
-from ..experiments.files import record_from_run
-from ..experiments.frf import default_window, frf, peak_table
+from ..lab.files import record_from_run
+from ..lab.frf import default_window, frf, peak_table
 from ..model.params import ParameterError
 from . import figures as F
 

@@ -34,7 +34,7 @@ from scipy import signal as sps  # noqa: E402
 
 from ..study.metrics import CONTACT_CODES, QUANTITIES, psd  # noqa: E402
 from ..study.grid import label, panels  # noqa: E402
-from ..experiments.frf import field_unit  # noqa: E402
+from ..lab.frf import field_unit  # noqa: E402
 
 CODE_COLORS = dict(zip(CONTACT_CODES, plt.get_cmap("tab10").colors))
 SERIES_CHANNELS = (("force1", "force1 (dyn)"), ("strain1", "strain1 (-)"),
@@ -327,7 +327,7 @@ def code_series_diagrams(codes: dict[str, pd.Series], title: str, seconds: float
 def frf_figure(tables, responses, title: str, f_max: float | None = None):
     """|H|, the phase of H1 and the coherence of each response (one column each).
 
-    ``tables``: one FRF table (:func:`workbench.experiments.frf.frf`), drawn as H1 and
+    ``tables``: one FRF table (:func:`workbench.lab.frf.frf`), drawn as H1 and
     H2; or {source: table} (simulation over experiment), drawn as each source's H1."""
     sources = {"": tables} if isinstance(tables, pd.DataFrame) else dict(tables)
     single = len(sources) == 1

@@ -21,7 +21,7 @@ The residual is ``max(0, miss + SEARCH_MARGIN)``: 0 only where each rule holds
 with a margin, so that a search, which approaches a boundary from outside,
 ends inside it.  The estimator's cost (half the sum of squares) is 0 where
 every observation holds with that margin, and
-:func:`workbench.experiments.estimate.fit` searching the parameters within
+:func:`workbench.lab.estimate.fit` searching the parameters within
 their ranges either finds such a set or ends where the misses are smallest;
 :func:`misses` says which rules still miss there (a miss above 0).
 
@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import observations as O
-from ..experiments.matching import Setup
+from ..lab.matching import Setup
 from ..model.params import Parameters
 from ..model.regimes import contact_shares_of
 from ..study.metrics import LINE_MARGIN_DB, line_level

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from . import figures as F
-from .report import accuracy_lines, range_lines
+from .point_checks import accuracy_lines, range_lines
 from . import observations as O
 from ..model.modes import natural_frequencies
 from ..study.provenance import environment

@@ -11,7 +11,7 @@ from pathlib import Path
 _PACKAGE = Path(__file__).resolve().parents[1]          # workbench/
 PACKAGES = ("numba", "numpy", "scipy", "pandas", "joblib", "pyarrow", "matplotlib", "SALib")
 #: The sub-packages whose code computes a sweep's points; the others (present/,
-#: experiments/, identify/, reference/, the command line) only read or present them.
+#: lab/, identify/, reference/, the command line) only read or present them.
 COMPUTING = ("core", "model", "study")
 
 

@@ -3,12 +3,12 @@
 The rig's LabVIEW instruments wrote the sensors of Table 2 (seed §3.3-3.4):
 Force1, Strain1, Accel1, Contact1-4, Accel2, Strain2, Accel3; an impact
 test adds the hammer's force gauge (Hammer, a force channel: §4.3, §5.4).  Every file
-format (:mod:`workbench.experiments.formats`) reads into the same record: a
+format (:mod:`workbench.lab.formats`) reads into the same record: a
 DataFrame indexed by time ``t`` (s), with the workbench's channel names
 (``force1`` ... ``accel3``, ``contact1-4``) in CGS units, and the attributes
 
 - ``attrs["meta"]``: the run's settings (``WB_`` keys of the file; see
-  :mod:`workbench.experiments.matching` for what they mean);
+  :mod:`workbench.lab.matching` for what they mean);
 - ``attrs["units_assumed"]``: the channels whose file gave no unit and that
   were read in :data:`DEFAULT_UNITS`;
 - ``attrs["source"]``: the file.

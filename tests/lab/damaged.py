@@ -1,7 +1,7 @@
 """The check of a damaged file shared by the format tests."""
 import numpy as np
 
-from workbench.experiments import files as F
+from workbench.lab import files as F
 
 
 def reads_cleanly_or_fails_clearly(path) -> None:

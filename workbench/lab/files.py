@@ -6,8 +6,8 @@
     convert("trial.lvm", "trial.uff")
 
 The record (channels of Table 2, units, settings) is described in
-:mod:`workbench.experiments.channels`; each format is one module of
-:mod:`workbench.experiments.formats`:
+:mod:`workbench.lab.channels`; each format is one module of
+:mod:`workbench.lab.formats`:
 
 | format | suffixes | read by | written by |
 |---|---|---|---|

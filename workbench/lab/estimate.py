@@ -182,7 +182,7 @@ def check_start(start: dict, bounds: dict | None = None) -> dict:
 def fit(targets: list, start: dict[str, float], *, bounds: dict | None = None, jobs: int = 2,
         max_nfev: int = 30, xtol: float = 1e-3, fd_step: float = FD_STEP) -> Estimate:
     """Fit the parameters named in ``start`` to ``targets``: each has a ``setup`` (a
-    :class:`~workbench.experiments.matching.Setup`), ``labels`` (one per residual) and
+    :class:`~workbench.lab.matching.Setup`), ``labels`` (one per residual) and
     ``residuals(run)``, zero where the run matches it (:class:`RecordTarget`, or the paper's
     observations of :mod:`workbench.present.observed`).  Nonlinear least squares in the
     parameters' logs within ``bounds`` (default FITTABLE's), the Jacobian by forward

@@ -1,4 +1,4 @@
-"""FRFs (workbench/experiments/frf.py): H1, H2 and the coherence on cases with known answers."""
+"""FRFs (workbench/lab/frf.py): H1, H2 and the coherence on cases with known answers."""
 from __future__ import annotations
 
 import json
@@ -9,7 +9,7 @@ import pytest
 from scipy import signal
 
 from workbench import cli
-from workbench.experiments.frf import frf, peaks
+from workbench.lab.frf import frf, peaks
 from workbench.model import drives, packing as mdl
 from workbench.model.modes import natural_frequencies
 from workbench.model.params import ParameterError, Parameters
@@ -140,7 +140,7 @@ def test_the_impact_windows_give_the_mode_and_the_corrected_damping():
 
 
 def test_the_default_window_follows_the_drive():
-    from workbench.experiments.frf import default_window
+    from workbench.lab.frf import default_window
     assert [default_window(d) for d in ("hammer_tip", "hammer_joint", "chirp", "sine", None)] \
         == ["impact", "impact", "rect", "hann", "hann"]
     with pytest.raises(ParameterError, match="window = 'flattop'; allowed: hann, rect, impact"):

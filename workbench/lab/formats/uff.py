@@ -216,7 +216,7 @@ def write(path, record, meta: dict | None = None) -> Path:
 
 def write_frf(path, table, responses, force: str = "force1", estimate: str = "H1",
               meta: dict | None = None) -> Path:
-    """Write FRFs (:func:`workbench.experiments.frf.frf`'s table, CGS ratios) as UFF
+    """Write FRFs (:func:`workbench.lab.frf.frf`'s table, CGS ratios) as UFF
     dataset 58, function type 4, in SI: each response over the force."""
     path = Path(path)
     f = table.index.to_numpy(dtype=float)

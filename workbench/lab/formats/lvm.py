@@ -6,7 +6,7 @@ segments of a header, the column names after ``X_Value`` and the rows), so
 that a damaged file ends in an :class:`ExperimentFileError` naming the line.
 Header keys starting with ``WB_`` are the record's settings.  Each segment
 gives one ``Y_Unit_Label`` per channel; a channel without one is read in
-:data:`~workbench.experiments.channels.DEFAULT_UNITS`.
+:data:`~workbench.lab.channels.DEFAULT_UNITS`.
 """
 from __future__ import annotations
 

@@ -6,10 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.experiments import files as F
+from workbench.lab import files as F
 from workbench.cli import main
-from workbench.experiments.estimate import estimate
-from workbench.experiments.matching import setup_from
+from workbench.lab.estimate import estimate
+from workbench.lab.matching import setup_from
 from workbench.model.params import ParameterError
 
 HIDDEN = {"e_b": 6.0e11, "force_n": 14.0}

@@ -1,6 +1,6 @@
 """The simulation that matches a record: its model parameters, excitation and length.
 
-A record's settings come from its file (``WB_`` keys, :mod:`workbench.experiments.files`)
+A record's settings come from its file (``WB_`` keys, :mod:`workbench.lab.files`)
 and from the command line, which wins.  The keys are those of a study
 (:mod:`workbench.study.definition`): ``drive`` (a kind of
 :mod:`workbench.model.drives`: sine, chirp, free_decay, hammer_joint,

@@ -10,7 +10,7 @@ draws the paper's comparisons from these and writes them:
    patch reads 1 V while its point is closed);
 4. for chirps, spectrograms of strain1 (Fig. 11-12);
 5. for chirps, the FRFs (H1 and coherence of each acceleration and strain
-   against force1, :mod:`workbench.experiments.frf`), simulation over
+   against force1, :mod:`workbench.lab.frf`), simulation over
    record, with the peaks of each in the chirp's band (a sine's force has
    no band to refer a response to).
 

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 from hypothesis import HealthCheck, example, given, settings, strategies as st
 
-from workbench.experiments import files as F
+from workbench.lab import files as F
 
 from damaged import reads_cleanly_or_fails_clearly
 

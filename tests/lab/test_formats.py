@@ -9,11 +9,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from workbench import cli
-from workbench.experiments import files as F
+from workbench.lab import files as F
 
 from damaged import reads_cleanly_or_fails_clearly
-from workbench.experiments.formats import uff
-from workbench.experiments.matching import settings_of, setup_from
+from workbench.lab.formats import uff
+from workbench.lab.matching import settings_of, setup_from
 from workbench.model.params import Parameters
 
 SUFFIXES = {"lvm": ".lvm", "text": ".txt", "tdms": ".tdms", "uff": ".uff", "parquet": ".parquet"}

@@ -1,2 +1,0 @@
-"""The file formats of a record, one module each: ``read(path, strain_scale)`` and
-``write(path, record, meta)`` (:mod:`workbench.experiments.files` picks one by suffix)."""
