@@ -30,7 +30,8 @@ from joblib import Parallel, delayed
 
 from workbench.model.drives import chirp, sine
 from workbench.model.params import Parameters
-from workbench.model.simulate import default_dt, simulate
+from workbench.model.step_policy import default_dt
+from workbench.model.simulate import simulate
 from workbench.model.accuracy import companion_settings, difference
 
 DURATION_S = 1.0

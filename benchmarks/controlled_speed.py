@@ -17,7 +17,8 @@ import statistics
 
 from workbench.model.drives import chirp, sine
 from workbench.model.params import Parameters
-from workbench.model.simulate import default_dt, simulate
+from workbench.model.step_policy import default_dt
+from workbench.model.simulate import simulate
 
 
 def cases(with_chirp: bool) -> dict:

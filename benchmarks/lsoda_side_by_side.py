@@ -38,7 +38,8 @@ from workbench.model import packing as mdl
 from workbench.model.drives import sine
 from workbench.model.params import Parameters
 from workbench.model.regimes import contact_code, is_stick, regime_of, set_of
-from workbench.model.simulate import default_dt, simulate, stepped_dt
+from workbench.model.step_policy import default_dt, stepped_dt
+from workbench.model.simulate import simulate
 
 #: atol of every state component = ATOL_REL * rtol (cm, rad, cm/s, rad/s):
 #: the axial coordinates move by ~1e-6 cm.
@@ -73,7 +74,7 @@ class CompiledLSODA:
 
     def _regime_args(self):
         w = self.work
-        return (*self.model, self.ex, w.rec, w.mat, w.vec, w.cg, w.cw, w.rg)
+        return (self.model, self.ex, w)
 
     def _eval(self, t, y):
         key = (t, y.tobytes())
@@ -110,8 +111,7 @@ class CompiledLSODA:
         cur[:] = 0.0
         cur[:ly.N_STATE] = y
         while e >= 0:
-            status = apply_event(e, t, *self.model, self.ex, w.rec, w.mat, w.vec, w.stages, w.cg,
-                                 w.cw, w.rg, w.ev, self.log, 0, self.st)
+            status = apply_event(e, t, self.model, self.ex, w, self.log, 0, self.st)
             if status != ly.OK:
                 raise RuntimeError(f"apply_event status {status} at t = {t}")
             e = _immediate_impact(w.ev)
@@ -134,8 +134,7 @@ class CompiledLSODA:
             tip_a = self._tip(t, y)
             cur[:] = 0.0
             cur[:ly.N_STATE] = y
-            status = _stepped(t, h, *self.model, self.ex, w.rec, w.mat, w.vec, w.stages, w.cg,
-                              w.cw, w.rg, w.ev, self.st)
+            status = _stepped(t, h, self.model, self.ex, w, self.st)
             if status != ly.OK:
                 raise RuntimeError(f"Moreau-Jean step status {status} at t = {t}")
             y = cur[:ly.N_STATE].copy()
@@ -166,8 +165,7 @@ class CompiledLSODA:
         self.st[ly.ST_FLOOD_T0] = -1e300
         self.y[:] = 0.0
         self.y[:ly.N_STATE] = y0
-        status = choose_regime(t0, self.y, *self.model, self.ex, w.rec, w.mat, w.vec, w.stages,
-                               w.cg, w.cw, w.rg, w.stages[ly.STAGE_K1], self.st, GAP_TOL)
+        status = choose_regime(t0, self.y, self.model, self.ex, w, w.stages[ly.STAGE_K1], self.st, GAP_TOL)
         if status != ly.OK:
             raise RuntimeError(f"choose_regime status {status}")
         t, y = t0, self.y[:ly.N_STATE].copy()

@@ -34,7 +34,9 @@ RHS, RHS_REGIME = 3, 4              # the indices of the whole right-hand sides 
 # cached loop would keep the machine code of kernels edited since
 # (workbench/core/_cache.py keys only the kernels of workbench.core).
 @nb.njit
-def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
+def repeat(which, n, y, model, ex, work, ydot):
+    P, tab, kc, free = model
+    rec, mat, vec, stages, cg, cw, rg, ev = work
     status = 0
     for i in range(n):
         y[0] += 1e-12                                   # defeat hoisting
@@ -49,15 +51,13 @@ def repeat(which, n, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
         elif which == RHS:
             status |= rhs(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
         elif which == RHS_REGIME:
-            status |= rhs_regime(1e-3 * i, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                                 ydot)
+            status |= rhs_regime(1e-3 * i, y, model, ex, work, ydot)
         elif which == 6:
             project(y, P, free, cg, cw, rg, np.bool_(False))
         elif which == 7:
             event_values(y, P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
         else:
-            status |= rk_step(1e-3 * i, y, 1e-5, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
-                               cw, rg, stages[ly.STAGE_NEXT])
+            status |= rk_step(1e-3 * i, y, 1e-5, model, ex, work, stages[ly.STAGE_NEXT])
     return status
 
 
@@ -72,11 +72,11 @@ def main(rounds=7, calls=100_000):
     for which, (set_index, stick) in cases:
         work.rg[:] = 0.0
         work.rg[ly.RG_SET], work.rg[ly.RG_STICK], work.rg[ly.RG_SIGN] = set_index, stick, 1.0
-        repeat(which, 10, y.copy(), *model, ex, *work, ydot)
+        repeat(which, 10, y.copy(), model, ex, work, ydot)
         times = []
         for _ in range(rounds):
             t0 = time.perf_counter()
-            repeat(which, calls, y.copy(), *model, ex, *work, ydot)
+            repeat(which, calls, y.copy(), model, ex, work, ydot)
             times.append((time.perf_counter() - t0) / calls * 1e6)
         regime = f" (set {set_index}, {'stick' if stick else 'slip'})" if which >= RHS_REGIME else ""
         print(f"{PARTS[which] + regime:40s} {np.median(times):6.2f} us")

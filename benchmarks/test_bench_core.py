@@ -33,9 +33,9 @@ def test_rhs_evaluation(benchmark, fixed):
     model, work = mdl.build(Parameters(), fixed=fixed), mdl.make_work()
     y, ydot = _state(), np.zeros(18)
     ex = sine(1.0, 20.0)
-    repeat(RHS, 10, y, *model, ex, *work, ydot)
+    repeat(RHS, 10, y, model, ex, work, ydot)
     benchmark.extra_info["calls_per_round"] = N_CALLS
-    status = benchmark(repeat, RHS, N_CALLS, y, *model, ex, *work, ydot)
+    status = benchmark(repeat, RHS, N_CALLS, y, model, ex, work, ydot)
     assert status == 0
 
 
@@ -53,10 +53,10 @@ def test_rhs_regime_evaluation(benchmark, regime):
     y, ydot = np.zeros(ly.N_AUG), np.zeros(ly.N_AUG)
     y[:ly.N_STATE] = _state()
     ex = sine(1.0, 20.0)
-    repeat(RHS_REGIME, 10, y, *model, ex, *work, ydot)
+    repeat(RHS_REGIME, 10, y, model, ex, work, ydot)
     rows = 0 if set_index == 0 else (2 if set_index > 4 else 1) + int(stick)
     benchmark.extra_info.update({"calls_per_round": N_CALLS, "constraint_rows": rows})
-    status = benchmark(repeat, RHS_REGIME, N_CALLS, y, *model, ex, *work, ydot)
+    status = benchmark(repeat, RHS_REGIME, N_CALLS, y, model, ex, work, ydot)
     assert status == 0
 
 

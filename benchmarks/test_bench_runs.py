@@ -21,7 +21,8 @@ import pytest
 from cases import (CASES, CONVERGED_DT, controlled_window, fixed_run, full_run,
                           kernel_window, lsoda_window, window_start)
 from workbench.model.limits import DEFAULT_TOL
-from workbench.model.simulate import default_dt, simulate
+from workbench.model.step_policy import default_dt
+from workbench.model.simulate import simulate
 
 #: The kernel's steps on the windows, as fractions of the case's default step.
 STEP_FRACTIONS = (1.0, 0.5, 0.25, 0.125)

@@ -29,7 +29,7 @@ __version__ = "0.1.0"
 
 #: Each name of the API and the module that defines it (the name there, if another).
 _API = {
-    "simulate": ("model.simulate", "simulate"), "Run": ("model.simulate", "Run"),
+    "simulate": ("model.simulate", "simulate"), "Run": ("model.run_result", "Run"),
     "static_equilibrium": ("model.statics", "static_equilibrium"),
     "natural_frequencies": ("model.modes", "natural_frequencies"),
     "mode_shapes": ("model.modes", "mode_shapes"),

@@ -13,7 +13,8 @@ from workbench.model import drives
 from workbench.model import packing as mdl
 from workbench.model.limits import DEFAULT_TOL
 from workbench.model.params import ParameterError, Parameters
-from workbench.model.simulate import default_dt, simulate
+from workbench.model.step_policy import default_dt
+from workbench.model.simulate import simulate
 from workbench.model.tableaus import DOPRI5, write_tableau
 
 ALL = set(ly.COORD_NAMES)
@@ -71,11 +72,9 @@ def test_the_dense_output_has_the_interpolants_order():
     st = np.zeros(ly.N_ST)
 
     def step(t, y, h, out):
-        assert rhs_regime(t, y, *model, ex, work.rec, work.mat, work.vec, work.cg, work.cw,
-                          work.rg, work.stages[ly.STAGE_K1]) == ly.OK
+        assert rhs_regime(t, y, model, ex, work, work.stages[ly.STAGE_K1]) == ly.OK
         work.ev[:] = 1.0
-        assert pair_step(t, y, h, *model, ex, work.rec, work.mat, work.vec, work.stages, work.cg,
-                         work.cw, work.rg, work.ev, st, out) == ly.OK
+        assert pair_step(t, y, h, model, ex, work, st, out) == ly.OK
 
     errors = []
     hs = np.array([4e-4, 2e-4, 1e-4])

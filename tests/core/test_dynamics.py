@@ -24,7 +24,7 @@ CONSERVATIVE = dict(zeta_a=0.0, zeta_b=0.0, cork="linear", cork_c=0.0, k_v=2.0e6
 
 def total_energy(model, y, work):
     out = np.zeros(4)
-    energies(y, *model, *work, out)
+    energies(y, model, work, out)
     return out
 
 
@@ -32,7 +32,7 @@ def total_energy(model, y, work):
 def test_mass_matrix_symmetric_positive_definite(params, seed):
     model, work = mdl.build(params), mdl.make_work()
     y = random_state(np.random.default_rng(seed))
-    eval_inertia(y[:9], y[9:], *model, *work)
+    eval_inertia(y[:9], y[9:], model, work)
     M = work.mat[ly.MAT_M]
     np.testing.assert_array_equal(M, M.T)
     assert np.linalg.eigvalsh(M).min() > 0.0
@@ -46,7 +46,7 @@ def test_kernel_agrees_with_the_jet_reference_pointwise(params, seed):
     model, work = mdl.build(p), mdl.make_work()
     y = random_state(np.random.default_rng(seed))
     ydot = np.zeros(18)
-    assert eval_rhs(0.0137, y, *model, ex, *work, ydot) == ly.OK
+    assert eval_rhs(0.0137, y, model, ex, work, ydot) == ly.OK
     expected = ref.rhs(0.0137, y)
     np.testing.assert_allclose(ydot, expected, rtol=1e-10, atol=1e-10 * np.abs(expected).max())
     # energies too
@@ -59,14 +59,14 @@ def test_gravity_force_is_minus_the_gradient_of_its_energy():
     model, work = mdl.build(p), mdl.make_work()
     y = random_state(np.random.default_rng(7))
     q = y[:9]
-    eval_inertia(q, np.zeros(9), *model, *work)
+    eval_inertia(q, np.zeros(9), model, work)
     Qg = work.vec[ly.VEC_Q].copy()
     grad = np.zeros(9)
     for j in range(9):
         dq = np.zeros(9)
         dq[j] = 1e-6
-        vp = eval_inertia(q + dq, np.zeros(9), *model, *work)
-        vm = eval_inertia(q - dq, np.zeros(9), *model, *work)
+        vp = eval_inertia(q + dq, np.zeros(9), model, work)
+        vm = eval_inertia(q - dq, np.zeros(9), model, work)
         grad[j] = (vp - vm) / 2e-6
     np.testing.assert_allclose(Qg, -grad, rtol=1e-6, atol=1e-6 * np.abs(grad).max())
 
@@ -166,7 +166,7 @@ def test_frame_sums_equal_the_element_sums(seed, tip):
     p = Parameters(tip_mass=tip)
     model, work = mdl.build(p), mdl.make_work()
     y = random_state(np.random.default_rng(seed))
-    v = eval_inertia(y[:9], y[9:], *model, *work)
+    v = eval_inertia(y[:9], y[9:], model, work)
     k = kinematics(model, y[:9], y[9:])
     m, J, a = k["mass"], k["J"], k["a"]
     M = np.einsum("k,kri,krj->ij", m, J, J) + np.einsum("k,ki,kj->ij", k["rot"], a, a)

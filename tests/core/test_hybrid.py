@@ -21,8 +21,8 @@ from workbench.core.transitions import impact
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.regimes import contact_code, regime_name
 from workbench.model.limits import STABILITY_MARGIN
-from workbench.model.simulate import (MAX_DEFAULT_DT, NICE_STEPS, default_dt, rk4_amplification,
-                                      simulate)
+from workbench.model.step_policy import MAX_DEFAULT_DT, NICE_STEPS, default_dt, rk4_amplification
+from workbench.model.simulate import simulate
 from workbench.model.modes import linear_eigenvalues
 from workbench.model.statics import static_equilibrium
 
@@ -110,8 +110,7 @@ def _impact_setup(p, point, q, qd):
     y = np.concatenate([q, qd, np.zeros(ly.N_AUG - ly.N_STATE)])
     work.rg[:] = 0.0
     yd = np.zeros(ly.N_AUG)
-    assert rhs_regime(0.0, y, *model[:4], drives.none(), work.rec, work.mat, work.vec, work.cg, work.cw,
-                      work.rg, yd) == ly.OK
+    assert rhs_regime(0.0, y, model, drives.none(), work, yd) == ly.OK
     return model, work, y
 
 

@@ -23,7 +23,9 @@ from workbench.core.hybrid import _stepped
 from workbench.core.transitions import moreau_jean_step
 from workbench.model.modes import linear_eigenvalues
 from workbench.model.params import ParameterError, Parameters
-from workbench.model.simulate import CONTACT_STAT_KEYS, default_dt, simulate, stepped_dt
+from workbench.model.run_result import CONTACT_STAT_KEYS
+from workbench.model.step_policy import default_dt, stepped_dt
+from workbench.model.simulate import simulate
 
 
 @pytest.mark.parametrize("cork", ["none", "linear", "cubic"])
@@ -54,7 +56,7 @@ def test_axial_coordinates_are_damped_at_their_own_zeta(tip):
     p = Parameters(tip_mass=tip)
     model, work = mdl.build(p), mdl.make_work()
     zero = np.zeros(ly.N_DOF)
-    eval_inertia(zero, zero, *model, *work)
+    eval_inertia(zero, zero, model, work)
     for beam, i in (("a", ly.U_A), ("b", ly.U_B)):
         assert p.axial_mass(beam) == pytest.approx(work.mat[ly.MAT_M][i, i], rel=1e-12)
         k = model.kc[ly.KC_K][i, i]
@@ -78,8 +80,7 @@ def test_moreau_jean_step_is_plastic_and_dissipative():
     work.rg[:] = 0.0
     st = np.zeros(ly.N_ST)
     h = 1e-4
-    status = moreau_jean_step(0.0, h, *model, drives.none(), work.rec, work.mat, work.vec, work.stages,
-                              work.cg, work.cw, work.rg, st)
+    status = moreau_jean_step(0.0, h, model, drives.none(), work, st)
     assert status == ly.OK
     after = work.stages[ly.STAGE_CUR]
     # the impulse stopped the approach of corner 2 (plastic) and removed energy
@@ -87,9 +88,9 @@ def test_moreau_jean_step_is_plastic_and_dissipative():
     assert st[ly.ST_E_STEPPED] > 0 and st[ly.ST_N_STEPPED] == 1
     contact_set = int(work.rg[ly.RG_SET])                # {2}, or {2, 4}: it lies flat
     assert 1 in (ly.SET_FIRST[contact_set], ly.SET_SECOND[contact_set])
-    eval_inertia(after[:ly.N_DOF], after[ly.N_DOF:ly.N_STATE], *model, *work)
+    eval_inertia(after[:ly.N_DOF], after[ly.N_DOF:ly.N_STATE], model, work)
     ke_after = kinetic_energy(after[ly.N_DOF:ly.N_STATE], work.mat)
-    eval_inertia(y[:ly.N_DOF], y[ly.N_DOF:ly.N_STATE], *model, *work)
+    eval_inertia(y[:ly.N_DOF], y[ly.N_DOF:ly.N_STATE], model, work)
     assert ke_after < kinetic_energy(y[ly.N_DOF:ly.N_STATE], work.mat)
 
 
@@ -115,7 +116,7 @@ def test_moreau_jean_episode_keeps_the_axial_modes_bounded(tip_mass):
         work.rg[:] = 0.0
         st = np.zeros(ly.N_ST)
         for k in range(steps):
-            assert _stepped(k * dt, dt, *model, drives.none(), *work, st) == ly.OK
+            assert _stepped(k * dt, dt, model, drives.none(), work, st) == ly.OK
         return max(abs(y[ly.N_DOF + ly.U_A]), abs(y[ly.N_DOF + ly.U_B])), st[ly.ST_N_STEPPED]
 
     rate, n_steps = episode(stepped_dt(p))

@@ -5,7 +5,8 @@ import pytest
 
 from workbench.model import accuracy, drives
 from workbench.model.params import ParameterError, Parameters
-from workbench.model.simulate import default_dt, simulate
+from workbench.model.step_policy import default_dt
+from workbench.model.simulate import simulate
 from workbench.study import definition as S
 
 CASE = (Parameters(), drives.sine(200.0, 20.0, ramp_s=0.1), 0.3)

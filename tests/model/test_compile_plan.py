@@ -75,13 +75,13 @@ def test_the_number_of_processes_from_the_environment(monkeypatch):
 
 def test_the_first_use_clock_counts_a_callers_compile_once():
     """WORKBENCH_COMPILE_JOBS=0: a run's compile_s adds the kernels compiled on first
-    use before its event loop (simulate.FirstUseClock); a callee compiled inside its
+    use before its event loop (kernel_loading.FirstUseClock); a callee compiled inside its
     caller's compile is not counted again."""
     import time
 
     import numba
 
-    from workbench.model.simulate import FirstUseClock
+    from workbench.model.kernel_loading import FirstUseClock
 
     @numba.njit
     def callee(x):

@@ -84,7 +84,8 @@ SCRIPT = textwrap.dedent("""\
     from workbench.model import drives
     from workbench.model.modes import natural_frequencies
     from workbench.model.params import ParameterError, Parameters
-    from workbench.model.simulate import default_dt, simulate
+    from workbench.model.step_policy import default_dt
+    from workbench.model.simulate import simulate
     from workbench.reference.equations import Reference, shaker
 
     out = {}

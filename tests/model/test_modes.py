@@ -45,7 +45,7 @@ def test_uniform_cantilever_limit():
                    rho_i_a=tiny)
     m = mdl.build(p, fixed=("s", "v", "psi", "w_B", "phi_B", "u_B"))
     work = mdl.make_work()
-    eval_inertia(np.zeros(9), np.zeros(9), *m, *work)
+    eval_inertia(np.zeros(9), np.zeros(9), m, work)
     f = m.free
     lam = scipy.linalg.eigh(m.kc[ly.KC_K][np.ix_(f, f)], work.mat[ly.MAT_M][np.ix_(f, f)],
                             eigvals_only=True)

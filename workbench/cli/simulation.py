@@ -76,7 +76,7 @@ def _run_drive(args) -> dict:
                            lambda key: f"the drive needs {key}", duration_s=args.duration)
 
 
-#: The run options behind the names of :func:`workbench.model.simulate.check_settings`.
+#: The run options behind the names of :func:`workbench.model.run_settings.check_settings`.
 RUN_OPTION_NAMES = {"duration": "--duration", "dt": "--dt", "output_hz": "--output-hz",
                     "method": "--method", "tol": "--tol",
                     "freq_hz": "--freq-hz", "f0_hz": "--chirp F0", "f1_hz": "--chirp F1",
@@ -89,7 +89,9 @@ def _cmd_run(args) -> int:
     from ..lab.matching import settings_of
     from ..model import drives
     from ..model.methods import METHODS
-    from ..model.simulate import check_method, check_settings, prepare_kernels, simulate
+    from ..model.run_settings import check_method, check_settings
+    from ..model.kernel_loading import prepare_kernels
+    from ..model.simulate import simulate
     n_drives = sum(x is not None for x in (args.freq_hz, args.chirp, args.free_decay, args.impulse,
                                            args.drive))
     if n_drives > 1:

@@ -61,7 +61,7 @@ LOG_RESERVE = 4 * (MAX_EVENTS_PER_STEP + 2)
 
 
 @nb.njit(**JIT)
-def step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, scale, ctl, t):
+def step_error(tol, model, ex, work, scale, ctl, t):
     """The step's estimate over ``tol``: the new state at STAGE_NEXT, its events in EV_END.
 
     The embedded solution y_new - err (STAGE_TRY) is evaluated in the same
@@ -69,6 +69,8 @@ def step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
     rg's).  Returns ``(status, estimate, component)``: the component of
     (q, q') (0..17) or the event function (N_STATE + e) with the largest ratio.
     """
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     y_new = stages[ly.STAGE_NEXT]
     err = stages[ly.STAGE_ERR]
     worst = 0.0
@@ -82,8 +84,7 @@ def step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
     for i in range(ly.N_AUG):
         y_hat[i] = y_new[i] - err[i]
     if int(rg[ly.RG_SET]) > 0:
-        status = rhs_regime(t, y_hat, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                            stages[ly.STAGE_KTRY])
+        status = rhs_regime(t, y_hat, model, ex, work, stages[ly.STAGE_KTRY])
         if status != ly.OK:
             return status, worst, arg
     event_values(y_hat, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
@@ -151,7 +152,7 @@ SLOPE_FRACTION = 1e-3
 
 
 @nb.njit(**JIT)
-def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st):
+def _step_past(e, theta, t, h, model, ex, work, st):
     """The state just past event e by steps of the pair from the step's start (into STAGE_HI).
 
     ``theta`` is where the dense output of the step (its stages intact)
@@ -166,10 +167,11 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
     the bracket is EVENT_TIME_TOL wide.  Returns ``(status, theta)``; the
     events at the state in EV_HI.
     """
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     f_past = ev[ly.EV_HI, e]
     x = theta - SLOPE_FRACTION if theta > SLOPE_FRACTION else theta + SLOPE_FRACTION
-    status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                    rg, ev)
+    status = _trial(x, t, h, np.bool_(True), model, ex, work)
     if status != ly.OK:
         return status, theta
     slope = (ev[ly.EV_TRY, e] - f_past) / (x - theta)
@@ -182,8 +184,7 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
-        status = pair_step(t, stages[ly.STAGE_CUR], x * h, P, tab, kc, free, ex, rec, mat, vec,
-                           stages, cg, cw, rg, ev, st, stages[ly.STAGE_HI])
+        status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st, stages[ly.STAGE_HI])
         if status != ly.OK:
             return status, x
         event_values(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
@@ -205,7 +206,7 @@ def _step_past(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, 
 
 
 @nb.njit(**JIT)
-def _earlier_on_steps(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def _earlier_on_steps(e, theta, t, h, model, ex, work):
     """Another event passed on the way to event e's state (STAGE_HI, its events in EV_HI)?
 
     The pair's steps may reach e later than its dense output did, and pass
@@ -213,13 +214,13 @@ def _earlier_on_steps(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stage
     by Brent's method on the pair's steps from the step's start, comes
     first.  Returns ``(status, event, theta)``, the state past it in STAGE_HI.
     """
+    ev = work.ev
     for _ in range(ly.N_EV):
         earlier = passed_before(e, ev)
         if earlier < 0:
             break
-        status, theta = _bracket(earlier, ev[ly.EV_START, earlier], theta,
-                                 ev[ly.EV_HI, earlier], t, h, np.bool_(False), P, tab, kc, free,
-                                 ex, rec, mat, vec, stages, cg, cw, rg, ev)
+        status, theta = _bracket(earlier, ev[ly.EV_START, earlier], theta, ev[ly.EV_HI, earlier], t,
+                                 h, np.bool_(False), model, ex, work)
         if status != ly.OK:
             return status, e, theta
         e = earlier
@@ -227,11 +228,11 @@ def _earlier_on_steps(e, theta, t, h, P, tab, kc, free, ex, rec, mat, vec, stage
 
 
 @nb.njit(**JIT)
-def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, work, out, log, st,
-                 control):
+def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control):
     """Integrate n_steps base steps dt (s) from (t0, y0) with steps chosen by the error.
 
-    The arrays come in named groups: ``model`` (P, tab, kc, free) and
+    ``span`` is (dt, n_steps, step0, decim), ``tolerance`` (tol, level_max).  The arrays
+    come in named groups: ``model`` (P, tab, kc, free) and
     ``work`` (rec, mat, vec, stages, cg, cw, rg, ev), as
     :mod:`workbench.model.packing` builds them; ``out`` (out_t, out_y,
     out_sig), the samples; ``control`` (ctl, scale, floor_log), the
@@ -246,6 +247,8 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
     between calls (zeros, with CTL_H_MIN = inf, before the first).
     Returns ``(status, n_stored, n_log)``.
     """
+    dt, n_steps, step0, decim = span
+    tol, level_max = tolerance
     P, tab, kc, free = model
     rec, mat, vec, stages, cg, cw, rg, ev = work
     out_t, out_y, out_sig = out
@@ -259,8 +262,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
     y = stages[ly.STAGE_CUR]
     for i in range(ly.N_AUG):
         y[i] = y0[i]
-    status, stored, n_log = begin(t0, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                  rg, ev, out_t, out_y, out_sig, log, st)
+    status, stored, n_log = begin(t0, step0, model, ex, work, out_t, out_y, out_sig, log, st)
     if status != ly.OK:
         return status, stored, n_log
     order = P[ly.P_RK_ORDER]
@@ -295,15 +297,13 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             t_next = min(st[ly.ST_STEPPED_UNTIL], t_stop)
             if b_next <= m_stop:
                 t_next = min(t_next, t_sample)
-            status = _stepped(t, t_next - t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                              rg, ev, st)
+            status = _stepped(t, t_next - t, model, ex, work, st)
             if status != ly.OK:
                 st[ly.ST_T] = t
                 return status, stored, n_log
             t = t_next
             if b_next <= m_stop and t >= t_sample - STEP_REMAINDER_REL * dt:
-                status = store(stored, t_sample, y, P, tab, kc, free, ex, rec, mat, vec, stages,
-                               cg, cw, rg, st, out_t, out_y, out_sig)
+                status = store(stored, t_sample, y, model, ex, work, st, out_t, out_y, out_sig)
                 if status != ly.OK:
                     return status, stored, n_log
                 stored += 1
@@ -312,28 +312,24 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
         h_try = min(h, h_max, t_stop - t)
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
-        status = pair_step(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-                           ev, st, stages[ly.STAGE_NEXT])
+        status = pair_step(t, y, h_try, model, ex, work, st, stages[ly.STAGE_NEXT])
         err = np.inf
         arg = -1
         force = 0.0
         if status == ly.OK:
             event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
             force = total_normal_force(rg)
-            status, err, arg = step_error(tol, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
-                                          cw, rg, ev, scale, ctl, t + h_try)
+            status, err, arg = step_error(tol, model, ex, work, scale, ctl, t + h_try)
         e = -1
         theta = 2.0
         if (status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9))
                 and P[ly.P_RK_EXTRA] > 0.0):
-            status = prepare_dense(t, y, h_try, P, tab, kc, free, ex, rec, mat, vec, stages, cg,
-                                   cw, rg)
+            status = prepare_dense(t, y, h_try, model, ex, work)
         if status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)):
             ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
             for k in range(ly.N_EV):
                 ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
-            status, e, theta = locate(t, h_try, np.bool_(True), P, tab, kc, free, ex, rec, mat,
-                                      vec, stages, cg, cw, rg, ev)
+            status, e, theta = locate(t, h_try, np.bool_(True), model, ex, work)
             if status == ly.OK and e >= 0:
                 te = _event_time_error(e, theta * h_try, ev, ev_err)
                 r = te / (tol * EVENT_TIME_SCALE_S)
@@ -377,8 +373,7 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             if not (e < 0 and x >= 1.0 - 1e-12):
                 y_s = stages[ly.STAGE_HI]
                 dense(min(x, 1.0), h_try, y, P, stages, y_s)
-            status = store(stored, t_sample, y_s, P, tab, kc, free, ex, rec, mat, vec, stages,
-                           cg, cw, rg, st, out_t, out_y, out_sig)
+            status = store(stored, t_sample, y_s, model, ex, work, st, out_t, out_y, out_sig)
             if status != ly.OK:
                 return status, stored, n_log
             stored += 1
@@ -392,11 +387,9 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
             t = t_end
         else:
             # one step of the pair from the step's start to the event
-            status, theta = _step_past(e, theta, t, h_try, P, tab, kc, free, ex, rec, mat, vec,
-                                       stages, cg, cw, rg, ev, st)
+            status, theta = _step_past(e, theta, t, h_try, model, ex, work, st)
             if status == ly.OK:
-                status, e, theta = _earlier_on_steps(e, theta, t, h_try, P, tab, kc, free, ex,
-                                                     rec, mat, vec, stages, cg, cw, rg, ev)
+                status, e, theta = _earlier_on_steps(e, theta, t, h_try, model, ex, work)
             if status != ly.OK:
                 st[ly.ST_T] = t
                 return status, stored, n_log
@@ -411,13 +404,11 @@ def run_adaptive(y0, t0, dt, n_steps, step0, decim, tol, level_max, model, ex, w
                 n_step_events += 1
                 if flooding(st, t) or n_step_events > MAX_EVENTS_PER_STEP:
                     st[ly.ST_STEPPED_UNTIL] = t + STEPPED_TIME_S
-                    status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                                        stages[ly.STAGE_K1])
+                    status = rhs_regime(t, y, model, ex, work, stages[ly.STAGE_K1])
                     if status != ly.OK:
                         return status, stored, n_log
                     break
-                status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                     rg, ev, log, n_log, st)
+                status = apply_event(e, t, model, ex, work, log, n_log, st)
                 if status != ly.OK:
                     st[ly.ST_T] = t
                     return status, stored, n_log

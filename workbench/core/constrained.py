@@ -162,13 +162,15 @@ def fill_delassus(free, mat, cw, m):
 
 
 @nb.njit(**JIT)
-def rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot):
+def rhs_regime(t, y, model, ex, work, ydot):
     """Right-hand side of the augmented state in the regime of ``rg``.
 
     Writes ydot (N_AUG,): (q', q'') and the powers integrated for the
     energy account (erg/s); the contact forces lambda (dyn) into rg.
     Returns a status code.
     """
+    P, tab, kc, free = model.P, model.tab, model.kc, model.free
+    rec, mat, vec, cg, cw, rg = work.rec, work.mat, work.vec, work.cg, work.cw, work.rg
     status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
     if status != ly.OK:
         return status

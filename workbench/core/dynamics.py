@@ -283,28 +283,34 @@ def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
 
 
 @nb.njit(**JIT)
-def eval_rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, ydot):
+def eval_rhs(t, y, model, ex, work, ydot):
     """:func:`rhs` as a compiled entry point: ``eval_rhs(t, y, *model, ex, *work, ydot)``."""
+    P, tab, kc, free = model.P, model.tab, model.kc, model.free
+    rec, mat, vec = work.rec, work.mat, work.vec
     return rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
 
 
 @nb.njit(**JIT)
-def eval_inertia(q, qd, P, tab, kc, free, rec, mat, vec, stages, cg, cw, rg, ev):
+def eval_inertia(q, qd, model, work):
     """:func:`assemble_inertia` as an entry point: ``eval_inertia(q, qd, *model, *work)``.
 
     Leaves M in mat[MAT_M], h in vec[VEC_H], gravity in vec[VEC_Q]; returns V_gravity.
     """
+    P, tab = model.P, model.tab
+    rec, mat, vec = work.rec, work.mat, work.vec
     return assemble_inertia(q, qd, P, tab, rec, mat, vec)
 
 
 @nb.njit(**JIT)
-def energies(y, P, tab, kc, free, rec, mat, vec, stages, cg, cw, rg, ev, out):
+def energies(y, model, work, out):
     """Energies of state y (erg) into out: kinetic, elastic, gravity, cork.
 
     Called as ``energies(y, *model, *work, out)``.
     Elastic includes the optional loose-body springs; cork is the potential
     of the cork spring.  Damping, forcing and contact do not enter.
     """
+    P, tab, kc = model.P, model.tab, model.kc
+    rec, mat, vec = work.rec, work.mat, work.vec
     q = y[:ly.N_DOF]
     qd = y[ly.N_DOF:]
     v_grav = assemble_inertia(q, qd, P, tab, rec, mat, vec)

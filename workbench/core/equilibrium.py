@@ -31,13 +31,15 @@ from .dynamics import add_applied_forces, assemble_inertia, cork_energy
 from .kinematics import element, n_elements
 
 @nb.njit(**JIT)
-def _residual(z, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat, vec, cg,
-              q, qd, Q, f):
+def _residual(z, case, model, ex, work, q, qd, Q, f):
     """f(z) into f; q, the force Q with the contact forces, and the geometry (cg) of z.
 
     Returns the tip's height (cm).  Not inlined: its callers call it five times,
     and each copy would compile the mass matrix's assembly again.
     """
+    q_base, coords, points, friction, tip_load = case
+    P, tab, kc = model.P, model.tab, model.kc
+    rec, mat, vec, cg = work.rec, work.mat, work.vec, work.cg
     nc = coords.size
     npt = points.size
     for i in range(ly.N_DOF):
@@ -120,14 +122,14 @@ def _gauss_solve(A, b, x, n):
 
 
 @nb.njit(**JIT_ALLOC)
-def static_state(z, q_base, coords, points, friction, tip_load, P, tab, kc, free, ex,
-                 rec, mat, vec, stages, cg, cw, rg, ev, q, Q, f, energy):
+def static_state(z, case, model, ex, work, q, Q, f, energy):
     """The state of unknowns z: q (9,), the force Q with the contact forces (9,), the
     scaled residual f, and energy (4,): elastic, gravity and cork potential (erg) and
     the tip's height (cm).  The gaps and their gradients are left in ``cg``."""
+    P, tab, kc = model.P, model.tab, model.kc
+    rec, mat, vec = work.rec, work.mat, work.vec
     qd = np.zeros(ly.N_DOF)
-    tip_y = _residual(z, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat,
-                      vec, cg, q, qd, Q, f)
+    tip_y = _residual(z, case, model, ex, work, q, qd, Q, f)
     K = kc[ly.KC_K]
     elastic = 0.0
     for i in range(ly.N_DOF):
@@ -140,10 +142,12 @@ def static_state(z, q_base, coords, points, friction, tip_load, P, tab, kc, free
 
 
 @nb.njit(**JIT_ALLOC)
-def newton_set(z, q_base, coords, points, friction, tip_load, tol, max_iter, max_damped,
-               P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def newton_set(z, case, tol, max_iter, max_damped, model, ex, work):
     """Solve f(z) = 0 from z (overwritten with the solution); returns a status.
 
+    ``case`` is (q_base, coords, points, friction, tip_load): the coordinates q (cm, rad)
+    the unknowns start from, the free coordinates and the set's points (int64 arrays),
+    whether friction holds the slide, and the vertical tip load (dyn).
     ``tol`` bounds the scaled residual's largest entry; ``max_iter`` Newton
     steps at most; ``max_damped`` damped steps in a row mean no equilibrium
     near the start.  Status: :data:`~workbench.core.layout.EQ_CONVERGED`,
@@ -160,9 +164,8 @@ def newton_set(z, q_base, coords, points, friction, tip_load, tol, max_iter, max
     z_try = np.zeros(n)
     dz = np.zeros(n)
     J = np.zeros((n, n))
-    _residual(z, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat, vec, cg,
-              q, qd, Q, f)
-    nc = coords.size
+    _residual(z, case, model, ex, work, q, qd, Q, f)
+    nc = case[1].size
     damped = 0
     for _ in range(max_iter):
         norm = _largest(f, n)
@@ -175,11 +178,9 @@ def newton_set(z, q_base, coords, points, friction, tip_load, tol, max_iter, max
             for i in range(n):
                 z_try[i] = z[i]
             z_try[j] = z[j] + step
-            _residual(z_try, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat,
-                      vec, cg, q, qd, Q, f_try)
+            _residual(z_try, case, model, ex, work, q, qd, Q, f_try)
             z_try[j] = z[j] - step
-            _residual(z_try, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat,
-                      vec, cg, q, qd, Q, f_minus)
+            _residual(z_try, case, model, ex, work, q, qd, Q, f_minus)
             for i in range(n):
                 J[i, j] = (f_try[i] - f_minus[i]) / (2.0 * step)
         for i in range(n):
@@ -190,8 +191,7 @@ def newton_set(z, q_base, coords, points, friction, tip_load, tol, max_iter, max
         while True:
             for i in range(n):
                 z_try[i] = z[i] + alpha * dz[i]
-            _residual(z_try, q_base, coords, points, friction, tip_load, P, tab, kc, ex, rec, mat,
-                      vec, cg, q, qd, Q, f_try)
+            _residual(z_try, case, model, ex, work, q, qd, Q, f_try)
             if _largest(f_try, n) < (1.0 - 0.25 * alpha) * norm or 0.5 * alpha <= ALPHA_MIN:
                 break
             alpha *= 0.5

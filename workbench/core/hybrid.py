@@ -65,24 +65,24 @@ def _copy_ev(ev, src, dst):
 
 
 @nb.njit(**JIT_INLINE)
-def _trial(theta, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def _trial(theta, t, h, on_dense, model, ex, work):
     """State after theta * h from the step's start into STAGE_TRY, its events into EV_TRY.
 
     ``on_dense``: the state is the dense output of the step just taken (its
     stages intact, :func:`workbench.core.pair.dense`); else a step of theta h
     is integrated from the step's start.
     """
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     y = stages[ly.STAGE_CUR]
     y_try = stages[ly.STAGE_TRY]
     status = ly.OK
     if on_dense:
         dense(theta, h, y, P, stages, y_try)
     else:
-        status = rk_step(t, y, theta * h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                         rg, y_try)
+        status = rk_step(t, y, theta * h, model, ex, work, y_try)
     if status == ly.OK:
-        status = rhs_regime(t + theta * h, y_try, P, tab, kc, free, ex, rec, mat, vec, cg, cw,
-                            rg, stages[ly.STAGE_KTRY])
+        status = rhs_regime(t + theta * h, y_try, model, ex, work, stages[ly.STAGE_KTRY])
     if status == ly.OK:
         event_values(y_try, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
     return status
@@ -124,8 +124,7 @@ def _hermite_min(f0, f1, m0, m1):
 
 
 @nb.njit(**JIT)
-def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-           rg, ev):
+def _graze(e, t, h, f0, f1, m0, m1, before, model, ex, work):
     """Does gap event e dip below zero inside the step though it is positive at both ends?
 
     The gap turns within the step (slopes m0 < 0 < m1 per unit theta).  The
@@ -138,6 +137,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
     theta of a state below zero (in STAGE_HI, its events in EV_HI) before
     ``before``, or -1.
     """
+    stages, ev = work.stages, work.ev
     x, v = _hermite_min(f0, f1, m0, m1)
     margin = GRAZE_MARGIN * (m1 - m0)
     if not v < margin:
@@ -146,8 +146,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
     for _ in range(GRAZE_ITERS):
         if not (0.0 < x < before):
             return ly.OK, -1.0
-        status = _trial(x, t, h, np.bool_(False), P, tab, kc, free, ex, rec, mat, vec, stages,
-                        cg, cw, rg, ev)
+        status = _trial(x, t, h, np.bool_(False), model, ex, work)
         if status != ly.OK:
             return status, -1.0
         f = ev[ly.EV_TRY, e]
@@ -169,8 +168,7 @@ def _graze(e, t, h, f0, f1, m0, m1, before, P, tab, kc, free, ex, rec, mat, vec,
 
 
 @nb.njit(**JIT)
-def _bracket(e, flo, hi, fhi, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-             rg, ev):
+def _bracket(e, flo, hi, fhi, t, h, on_dense, model, ex, work):
     """Locate event e's sign change in (0, hi) by Brent's method, to EVENT_TIME_TOL.
 
     Brent's zeroin (R. P. Brent, Algorithms for Minimization without
@@ -186,6 +184,7 @@ def _bracket(e, flo, hi, fhi, t, h, on_dense, P, tab, kc, free, ex, rec, mat, ve
     whose state is in STAGE_HI.  Trial states as :func:`_trial` (``on_dense``).  Returns ``(status, theta)``: the state just
     past the change (theta) is left in STAGE_HI, the events there in EV_HI.
     """
+    stages, ev = work.stages, work.ev
     half_tol = 0.5 * EVENT_TIME_TOL / h
     a, fa = 0.0, flo
     b, fb = hi, fhi
@@ -228,8 +227,7 @@ def _bracket(e, flo, hi, fhi, t, h, on_dense, P, tab, kc, free, ex, rec, mat, ve
             b += d
         else:
             b += half_tol if xm > 0.0 else -half_tol
-        status = _trial(b, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                        rg, ev)
+        status = _trial(b, t, h, on_dense, model, ex, work)
         if status != ly.OK:
             return status, hi
         fb = ev[ly.EV_TRY, e]
@@ -249,7 +247,7 @@ SCAN_POINTS = (0.2, 0.4, 0.5, 0.6, 0.8)
 
 
 @nb.njit(**JIT)
-def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def _scan(e, t, h, before, model, ex, work):
     """Is event e negative somewhere inside the step though positive at both ends? (dense output)
 
     Called when a sign check flagged it: e's smallest value over the step's
@@ -260,6 +258,8 @@ def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     is past the change by more than the function's error (ev[EV_NOISE]; in
     STAGE_HI, its events in EV_HI), or -1.
     """
+    P = model.P
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     xs = SCAN_POINTS
     x_min = -1.0
     if e < ly.EV_GAP + ly.N_POINTS:
@@ -279,8 +279,7 @@ def _scan(e, t, h, before, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
             p = e - ly.EV_GAP
             if not cg[ly.CG_G + p, ly.CG_VAL] + rg[ly.RG_ARM + p] < -ev[ly.EV_NOISE, e]:
                 continue
-        status = _trial(x, t, h, np.bool_(True), P, tab, kc, free, ex, rec, mat, vec, stages, cg,
-                        cw, rg, ev)
+        status = _trial(x, t, h, np.bool_(True), model, ex, work)
         if status != ly.OK:
             return status, -1.0
         if ev[ly.EV_TRY, e] < -ev[ly.EV_NOISE, e]:
@@ -301,7 +300,7 @@ def passed_before(e, ev):
 
 
 @nb.njit(**JIT)
-def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev):
+def locate(t, h, on_dense, model, ex, work):
     """The earliest event in the step (t, t + h) from STAGE_CUR to STAGE_NEXT.
 
     ``on_dense``: trial states are the dense output of the step just taken,
@@ -311,6 +310,7 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     event -1 if none; else the state just past the event (within
     EVENT_TIME_TOL) is in STAGE_HI at t + theta h.
     """
+    stages, ev = work.stages, work.ev
     best = -1
     best_theta = 2.0
     for e in range(ly.N_EV):
@@ -327,8 +327,7 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
             turning = (e < ly.EV_GAP + ly.N_POINTS and ev[ly.EV_RATE_START, e] < 0.0
                        and ev[ly.EV_RATE_END, e] > 0.0 and f0 < 1.0)
             if turning or ev[ly.EV_MIN, e] < -ev[ly.EV_NOISE, e]:
-                status, x = _scan(e, t, h, best_theta, P, tab, kc, free, ex, rec, mat, vec, stages,
-                                  cg, cw, rg, ev)
+                status, x = _scan(e, t, h, best_theta, model, ex, work)
                 if status != ly.OK:
                     return status, -1, 0.0
                 if x >= 0.0:
@@ -339,8 +338,7 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
             m0 = h * ev[ly.EV_RATE_START, e]
             m1 = h * ev[ly.EV_RATE_END, e]
             if m0 < 0.0 and m1 > 0.0:
-                status, x = _graze(e, t, h, f0, f1, m0, m1, best_theta, P, tab, kc, free, ex,
-                                   rec, mat, vec, stages, cg, cw, rg, ev)
+                status, x = _graze(e, t, h, f0, f1, m0, m1, best_theta, model, ex, work)
                 if status != ly.OK:
                     return status, -1, 0.0
                 if x >= 0.0:
@@ -357,8 +355,7 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
         elif hi == 1.0:
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
-        status, hi = _bracket(e, f0, hi, fhi, t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec,
-                              stages, cg, cw, rg, ev)
+        status, hi = _bracket(e, f0, hi, fhi, t, h, on_dense, model, ex, work)
         if status != ly.OK:
             return status, -1, 0.0
         best = e
@@ -372,9 +369,8 @@ def locate(t, h, on_dense, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
         earlier = passed_before(best, ev)
         if earlier < 0:
             break
-        status, hi = _bracket(earlier, ev[ly.EV_START, earlier], best_theta,
-                              ev[ly.EV_HI, earlier], t, h, on_dense, P, tab, kc, free, ex, rec,
-                              mat, vec, stages, cg, cw, rg, ev)
+        status, hi = _bracket(earlier, ev[ly.EV_START, earlier], best_theta, ev[ly.EV_HI, earlier],
+                              t, h, on_dense, model, ex, work)
         if status != ly.OK:
             return status, -1, 0.0
         best = earlier
@@ -436,12 +432,14 @@ def _accumulating(t, y, point, P, cg, st, k1):
 
 
 @nb.njit(**JIT)
-def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, log, n_log,
-                st):
+def apply_event(e, t, model, ex, work, log, n_log, st):
     """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
 
     Returns a status; the log row n_log is written.
     """
+    P, tab, kc, free = model.P, model.tab, model.kc, model.free
+    rec, mat, vec, stages = work.rec, work.mat, work.vec, work.stages
+    cg, cw, rg, ev = work.cg, work.cw, work.rg, work.ev
     y = stages[ly.STAGE_CUR]
     k1 = stages[ly.STAGE_K1]
     set_index = int(rg[ly.RG_SET])
@@ -449,7 +447,7 @@ def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, e
     # The bracketed state is not projected: pull it onto the old regime first,
     # so that e.g. a sticking slip velocity is exactly 0 when slip begins.
     project(y, P, free, cg, cw, rg, np.bool_(False))
-    status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k1)
+    status = rhs_regime(t, y, model, ex, work, k1)
     if status != ly.OK:
         return status
     point = 0
@@ -503,8 +501,7 @@ def apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, e
         project(y, P, free, cg, cw, rg, np.bool_(False))
         kind = ly.KIND_SLIP_STICK
         point = ly.SET_FIRST[set_index] + 1
-    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, k1, st,
-                           gap_tol)
+    status = choose_regime(t, y, model, ex, work, k1, st, gap_tol)
     if status != ly.OK:
         return status
     reg_to = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)
@@ -538,37 +535,39 @@ def _immediate_impact(ev):
 
 
 @nb.njit(**JIT_INLINE)
-def _stepped(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st):
+def _stepped(t, h, model, ex, work, st):
     """Moreau-Jean steps over h from (t, STAGE_CUR), then the regime chosen at t + h.
 
     The scheme is explicit in the smooth forces (leapfrog-like, stable for
     omega h < 2): h is split into the fewest equal steps of at most
     P[P_STEPPED_DT], which the model's fastest linear mode sets
-    (:func:`workbench.model.simulate.stepped_dt`); the integration step
+    (:func:`workbench.model.step_policy.stepped_dt`); the integration step
     itself may exceed it (classical RK4 is stable to omega h = 2.83).
     """
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     n = 1
     if h > P[ly.P_STEPPED_DT]:
         n = int(math.ceil(h / P[ly.P_STEPPED_DT]))
     for k in range(n):
-        status = moreau_jean_step(t + k * (h / n), h / n, P, tab, kc, free, ex, rec, mat, vec,
-                                  stages, cg, cw, rg, st)
+        status = moreau_jean_step(t + k * (h / n), h / n, model, ex, work, st)
         if status != ly.OK:
             return status
-    status = choose_regime(t + h, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec, stages,
-                           cg, cw, rg, stages[ly.STAGE_K1], st, GAP_TOL)
+    status = choose_regime(t + h, stages[ly.STAGE_CUR], model, ex, work, stages[ly.STAGE_K1], st,
+                           GAP_TOL)
     if status == ly.OK:
         event_values(stages[ly.STAGE_CUR], P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
     return status
 
 
 @nb.njit(**JIT)
-def store(stored, t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st,
-          out_t, out_y, out_sig):
+def store(stored, t, y, model, ex, work, st, out_t, out_y, out_sig):
     """Sample ``stored``: the state y at t in the regime of rg, and its signals (rg's
     forces and STAGE_KTRY are overwritten)."""
+    P, tab, kc = model.P, model.tab, model.kc
+    rec, mat, vec, stages, cg, rg = work.rec, work.mat, work.vec, work.stages, work.cg, work.rg
     k = stages[ly.STAGE_KTRY]
-    status = rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, k)
+    status = rhs_regime(t, y, model, ex, work, k)
     if status != ly.OK:
         return status
     out_t[stored] = t
@@ -579,13 +578,14 @@ def store(stored, t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
 
 
 @nb.njit(**JIT)
-def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, out_t, out_y,
-          out_sig, log, st):
+def begin(t, step0, model, ex, work, out_t, out_y, out_sig, log, st):
     """Start (or continue) a run at t from STAGE_CUR: the regime chosen, its events.
 
     On a run's first call (step0 == 0) the start is logged and stored too.
     Returns ``(status, n_stored, n_log)``.
     """
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     y = stages[ly.STAGE_CUR]
     n_log = 0
     stored = np.int64(0)
@@ -595,8 +595,7 @@ def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
         st[ly.ST_FLOOD_T0] = -1e300
         st[ly.ST_S_MIN] = y[ly.S]
         st[ly.ST_S_MAX] = y[ly.S]
-    status = choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-                           stages[ly.STAGE_K1], st, GAP_TOL)
+    status = choose_regime(t, y, model, ex, work, stages[ly.STAGE_K1], st, GAP_TOL)
     if status != ly.OK:
         return status, stored, n_log
     event_values(y, P, free, cg, rg, ev, ly.EV_START, ly.EV_RATE_START)
@@ -604,8 +603,7 @@ def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
         _log(log, n_log, t, ly.KIND_START, reg_start,
              regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0), 0)
         n_log += 1
-        status = store(stored, t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-                       st, out_t, out_y, out_sig)
+        status = store(stored, t, y, model, ex, work, st, out_t, out_y, out_sig)
         if status != ly.OK:
             return status, stored, n_log
         stored += 1
@@ -613,8 +611,7 @@ def begin(t, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
 
 
 @nb.njit(**JIT)
-def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-            ev, log, n_log, st):
+def advance(t, t_end, dt, stepped_left, model, ex, work, log, n_log, st):
     """One step of the lattice, from (t, STAGE_CUR) to t_end, with its events.
 
     ``dt`` (s) is the lattice step; ``stepped_left`` the Moreau-Jean steps
@@ -622,11 +619,12 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
     from n_log.  Returns ``(status, t, n_log, stepped_left)``; on success
     t == t_end and STAGE_CUR, STAGE_K1 and the events' start rows are at t.
     """
+    P, free = model.P, model.free
+    stages, cg, cw, rg, ev = work.stages, work.cg, work.cw, work.rg, work.ev
     y = stages[ly.STAGE_CUR]
     n_step_events = 0
     if stepped_left > 0:
-        status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
-                          ev, st)
+        status = _stepped(t, t_end - t, model, ex, work, st)
         if status != ly.OK:
             st[ly.ST_T] = t
             return status, t, n_log, stepped_left
@@ -638,19 +636,17 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
             break
         e = _immediate_impact(ev)
         if e < 0:
-            status = rk_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                             rg, stages[ly.STAGE_NEXT])
+            status = rk_step(t, y, h, model, ex, work, stages[ly.STAGE_NEXT])
             if status == ly.OK:
                 correction, drift = project(stages[ly.STAGE_NEXT], P, free, cg, cw, rg, np.bool_(False))
                 st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
                 st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
-                status = rhs_regime(t_end, stages[ly.STAGE_NEXT], P, tab, kc, free, ex, rec,
-                                    mat, vec, cg, cw, rg, stages[ly.STAGE_KNEXT])
+                status = rhs_regime(t_end, stages[ly.STAGE_NEXT], model, ex, work,
+                                    stages[ly.STAGE_KNEXT])
             if status != ly.OK:
                 return status, t, n_log, stepped_left
             event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-            status, e, theta = locate(t, h, np.bool_(False), P, tab, kc, free, ex, rec, mat, vec,
-                                      stages, cg, cw, rg, ev)
+            status, e, theta = locate(t, h, np.bool_(False), model, ex, work)
             if status != ly.OK:
                 return status, t, n_log, stepped_left
             if e < 0:
@@ -671,16 +667,14 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
                 # time-stepping through the rest of this step and STEPPED_TIME_S more
                 status = ly.OK
                 if t_end - t > STEP_REMAINDER_REL * dt:
-                    status = _stepped(t, t_end - t, P, tab, kc, free, ex, rec, mat, vec, stages,
-                                      cg, cw, rg, ev, st)
+                    status = _stepped(t, t_end - t, model, ex, work, st)
                 if status != ly.OK:
                     st[ly.ST_T] = t
                     return status, t, n_log, stepped_left
                 t = t_end
                 stepped_left = int(math.ceil(STEPPED_TIME_S / dt - 1e-9))
                 break
-            status = apply_event(e, t, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                 rg, ev, log, n_log, st)
+            status = apply_event(e, t, model, ex, work, log, n_log, st)
             if status != ly.OK:
                 st[ly.ST_T] = t
                 return status, t, n_log, stepped_left
@@ -691,10 +685,11 @@ def advance(t, t_end, dt, stepped_left, P, tab, kc, free, ex, rec, mat, vec, sta
 
 
 @nb.njit(**JIT)
-def run_hybrid(y0, t0, dt, n_steps, step0, decim, model, ex, work, out, log, st):
+def run_hybrid(y0, t0, span, model, ex, work, out, log, st):
     """Integrate n_steps fixed steps of dt (s) from (t0, y0) with contact events.
 
-    The arrays come in named groups: ``model`` (P, tab, kc, free) and
+    ``span`` is (dt, n_steps, step0, decim).  The arrays come in named groups:
+    ``model`` (P, tab, kc, free) and
     ``work`` (rec, mat, vec, stages, cg, cw, rg, ev), as
     :mod:`workbench.model.packing` builds them; ``out`` (out_t, out_y,
     out_sig), the samples.
@@ -710,6 +705,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, model, ex, work, out, log, st)
 
     Returns ``(status, n_stored, n_log)``.
     """
+    dt, n_steps, step0, decim = span
     P, tab, kc, free = model
     rec, mat, vec, stages, cg, cw, rg, ev = work
     out_t, out_y, out_sig = out
@@ -720,8 +716,7 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, model, ex, work, out, log, st)
         return ly.ERR_BAD_INPUT, 0, 0
     for i in range(ly.N_AUG):
         stages[ly.STAGE_CUR, i] = y0[i]
-    status, stored, n_log = begin(t0, step0, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                                  rg, ev, out_t, out_y, out_sig, log, st)
+    status, stored, n_log = begin(t0, step0, model, ex, work, out_t, out_y, out_sig, log, st)
     if status != ly.OK:
         return status, stored, n_log
     t = t0
@@ -729,15 +724,14 @@ def run_hybrid(y0, t0, dt, n_steps, step0, decim, model, ex, work, out, log, st)
     for step in range(1, n_steps + 1):
         if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
             return ly.LOG_FULL, stored, n_log
-        status, t, n_log, stepped_left = advance(t, t0 + step * dt, dt, stepped_left, P, tab, kc,
-                                                 free, ex, rec, mat, vec, stages, cg, cw, rg, ev,
-                                                 log, n_log, st)
+        status, t, n_log, stepped_left = advance(t, t0 + step * dt, dt, stepped_left, model, ex,
+                                                 work, log, n_log, st)
         if status != ly.OK:
             return status, stored, n_log
         st[ly.ST_STEP] = step0 + step
         if (step0 + step) % decim == 0:
-            status = store(stored, t, stages[ly.STAGE_CUR], P, tab, kc, free, ex, rec, mat, vec,
-                           stages, cg, cw, rg, st, out_t, out_y, out_sig)
+            status = store(stored, t, stages[ly.STAGE_CUR], model, ex, work, st, out_t, out_y,
+                           out_sig)
             if status != ly.OK:
                 return status, stored, n_log
             stored += 1

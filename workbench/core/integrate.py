@@ -40,21 +40,23 @@ def stage_state(r, t, y, h, P, stages, yt):
 
 
 @nb.njit(**JIT)
-def rk_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, y_new):
+def rk_step(t, y, dt, model, ex, work, y_new):
     """One step of the tableau in P from (t, y) into y_new (may not alias y) in the regime of rg.
 
     k1 = f(t, y) must already be in stages[STAGE_K1] (the caller evaluated
     it, e.g. for the events at the step's start); k_i goes to stages[i - 1].
     Zero coefficients a_ij are skipped.  Returns a status.
     """
+    P = model.P
+    stages = work.stages
     n = ly.N_AUG
     s = int(P[ly.P_RK_STAGES])
     yt = stages[ly.STAGE_TMP]
     for i in range(n):
         stages[0, i] = stages[ly.STAGE_K1, i]
     for st in range(1, s):
-        status = rhs_regime(stage_state(st, t, y, dt, P, stages, yt), yt, P, tab, kc, free, ex,
-                            rec, mat, vec, cg, cw, rg, stages[st])
+        status = rhs_regime(stage_state(st, t, y, dt, P, stages, yt), yt, model, ex, work,
+                            stages[st])
         if status != ly.OK:
             return status
     for i in range(n):
@@ -68,8 +70,7 @@ def rk_step(t, y, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, y
 
 
 @nb.njit(**JIT)
-def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, vec,
-                    stages, cg, cw, rg, ev, out_t, out_y):
+def integrate_fixed(y0, t0, dt, n_steps, decim, model, ex, work, out_t, out_y):
     """Integrate n_steps steps of size dt (s) from (t0, y0) in free flight.
 
     No contact: the loose body passes through the plates, so use it with the
@@ -80,6 +81,7 @@ def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, 
     n_stored)``; on failure the rows stored so far are valid and the failing
     state is not stored.
     """
+    stages, rg = work.stages, work.rg
     n_out = out_t.shape[0]
     if (out_y.shape[0] != n_out or n_out < n_steps // decim + 1
             or y0.shape[0] != ly.N_STATE or decim < 1):
@@ -95,11 +97,9 @@ def integrate_fixed(y0, t0, dt, n_steps, decim, P, tab, kc, free, ex, rec, mat, 
     stored = 1
     for step in range(1, n_steps + 1):
         t = t0 + (step - 1) * dt
-        status = rhs_regime(t, y_cur, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                            stages[ly.STAGE_K1])
+        status = rhs_regime(t, y_cur, model, ex, work, stages[ly.STAGE_K1])
         if status == ly.OK:
-            status = rk_step(t, y_cur, dt, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw,
-                             rg, y_next)
+            status = rk_step(t, y_cur, dt, model, ex, work, y_next)
         if status != ly.OK:
             return status, stored
         for i in range(ly.N_AUG):

@@ -38,7 +38,7 @@ def _stage_events_min(yt, P, free, cg, rg, ev):
 
 
 @nb.njit(**JIT)
-def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ev, st, y_new):
+def pair_step(t, y, h, model, ex, work, st, y_new):
     """One step of h (s) of the pair in P from (t, y) into y_new (may not alias y).
 
     k1 = f(t, y) must be in stages[STAGE_K1]; k_i goes to stages[i - 1], the
@@ -50,6 +50,8 @@ def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
     EV_TRY is overwritten).
     Returns a status.
     """
+    P, free = model.P, model.free
+    stages, cg, cw, rg, ev = work.stages, work.cg, work.cw, work.rg, work.ev
     n = ly.N_AUG
     s = int(P[ly.P_RK_STAGES])
     yt = stages[ly.STAGE_TMP]
@@ -58,8 +60,7 @@ def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
     for i in range(n):
         stages[0, i] = stages[ly.STAGE_K1, i]
     for r in range(1, s - 1):
-        status = rhs_regime(stage_state(r, t, y, h, P, stages, yt), yt, P, tab, kc, free, ex,
-                            rec, mat, vec, cg, cw, rg, stages[r])
+        status = rhs_regime(stage_state(r, t, y, h, P, stages, yt), yt, model, ex, work, stages[r])
         if status != ly.OK:
             return status
         _stage_events_min(yt, P, free, cg, rg, ev)
@@ -73,8 +74,7 @@ def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
     correction, drift = project(y_new, P, free, cg, cw, rg, np.bool_(False))
     st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
     st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
-    status = rhs_regime(t + h, y_new, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg,
-                        stages[s - 1])
+    status = rhs_regime(t + h, y_new, model, ex, work, stages[s - 1])
     if status != ly.OK:
         return status
     err = stages[ly.STAGE_ERR]
@@ -96,17 +96,18 @@ def pair_step(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, 
 
 
 @nb.njit(**JIT)
-def prepare_dense(t, y, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg):
+def prepare_dense(t, y, h, model, ex, work):
     """The stages the dense output needs beyond the step's own (P[P_RK_EXTRA] of them).
 
     Called after :func:`pair_step` from (t, y) with h, before :func:`dense`.
     Returns a status.
     """
+    P = model.P
+    stages = work.stages
     s = int(P[ly.P_RK_STAGES])
     yt = stages[ly.STAGE_TMP]
     for r in range(s, s + int(P[ly.P_RK_EXTRA])):
-        status = rhs_regime(stage_state(r, t, y, h, P, stages, yt), yt, P, tab, kc, free, ex,
-                            rec, mat, vec, cg, cw, rg, stages[r])
+        status = rhs_regime(stage_state(r, t, y, h, P, stages, yt), yt, model, ex, work, stages[r])
         if status != ly.OK:
             return status
     return ly.OK

@@ -251,9 +251,10 @@ def _violation(y, P, free, cg, rg, ydot, pts, m, slip_from_rest):
 
 
 @nb.njit(**JIT)
-def _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, set_index, stick, sign,
-              slip_from_rest):
+def _evaluate(y, model, work, a0, ydot, pts, m, set_index, stick, sign, slip_from_rest):
     """Contact forces of one candidate regime from the free accelerations a0; its violation."""
+    P, free = model.P, model.free
+    mat, cg, cw, rg = work.mat, work.cg, work.cw, work.rg
     rg[ly.RG_SET] = set_index
     rg[ly.RG_STICK] = 1.0 if stick else 0.0
     rg[ly.RG_SIGN] = sign
@@ -264,12 +265,14 @@ def _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, set_index, stick, s
 
 
 @nb.njit(**JIT)
-def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
+def _enumerate(y, model, work, a0, ydot, pts, m, best):
     """Try the proposed regime (in rg), then every regime over pts; the first consistent wins.
 
     best (3,) receives (set, stick, sign) of the consistent regime or,
     if there is none, of the least violated.  Returns True if consistent.
     """
+    P = model.P
+    cg, rg = work.cg, work.rg
     qd = y[ly.N_DOF:ly.N_STATE]
     p_set = int(rg[ly.RG_SET])
     p_stick = rg[ly.RG_STICK] != 0.0
@@ -303,7 +306,7 @@ def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
                 if set_index < 0:
                     continue
         if set_index == 0:
-            v = _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, np.int64(0), np.bool_(False), 1.0,
+            v = _evaluate(y, model, work, a0, ydot, pts, m, np.int64(0), np.bool_(False), 1.0,
                           np.bool_(False))
             if v < best_v:
                 best_v = v
@@ -333,7 +336,7 @@ def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
                 if not stick and not at_rest:
                     if (rate > 0.0) != (mode == 1):
                         continue
-            v = _evaluate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, set_index, stick, sign,
+            v = _evaluate(y, model, work, a0, ydot, pts, m, set_index, stick, sign,
                           (not stick) and at_rest)
             if v < best_v:
                 best_v = v
@@ -346,8 +349,7 @@ def _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best):
 
 
 @nb.njit(**JIT)
-def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, ydot, st,
-                  gap_tol):
+def choose_regime(t, y, model, ex, work, ydot, st, gap_tol):
     """Choose the consistent regime at y (docs/model.md §7 "Choosing the regime").
 
     The regime in rg is the proposal.  Projects y onto the chosen regime
@@ -358,6 +360,9 @@ def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
     then, the least violated regime is taken (st[ST_N_UNRESOLVED]).
     Returns a status code (errors only for NaN or a singular mass matrix).
     """
+    P, tab, kc, free = model.P, model.tab, model.kc, model.free
+    rec, mat, vec = work.rec, work.mat, work.vec
+    stages, cg, cw, rg = work.stages, work.cg, work.cw, work.rg
     a0 = stages[ly.STAGE_QD]
     best = cw[ly.CW_MODES]
     pts = cw[ly.CW_PTS]
@@ -368,7 +373,7 @@ def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
         for j in range(ly.N_DOF):
             a0[j] = ydot[ly.N_DOF + j]
         m = closed_points(y, np.int64(-1), P, cg, rg, pts, gap_tol, CLOSED_RATE, np.float64(0.0))
-        consistent = _enumerate(y, P, free, mat, cg, cw, rg, a0, ydot, pts, m, best)
+        consistent = _enumerate(y, model, work, a0, ydot, pts, m, best)
         rg[ly.RG_SET] = best[0]
         rg[ly.RG_STICK] = best[1]
         rg[ly.RG_SIGN] = best[2]
@@ -385,7 +390,7 @@ def choose_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg,
         st[ly.ST_E_IMPACT] += lost
     project(y, P, free, cg, cw, rg, np.bool_(True))
     arm_gaps(y, P, cg, rg)
-    return rhs_regime(t, y, P, tab, kc, free, ex, rec, mat, vec, cg, cw, rg, ydot)
+    return rhs_regime(t, y, model, ex, work, ydot)
 
 
 @nb.njit(**JIT)
@@ -407,7 +412,7 @@ def arm_gaps(y, P, cg, rg):
 
 
 @nb.njit(**JIT)
-def moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, rg, st):
+def moreau_jean_step(t, h, model, ex, work, st):
     """One Moreau-Jean step (theta = 1/2) of h (s) from STAGE_CUR, in place (docs/model.md §7).
 
     Acary & Brogliato (2008), §10.1: q_m = q + h/2 q'; the free velocity
@@ -418,6 +423,9 @@ def moreau_jean_step(t, h, P, tab, kc, free, ex, rec, mat, vec, stages, cg, cw, 
     st[ST_E_STEPPED] and st[ST_E_IMPACT].  Leaves the regime read from the
     impulses in rg (to be chosen again).  Returns a status.
     """
+    P, tab, kc, free = model.P, model.tab, model.kc, model.free
+    rec, mat, vec = work.rec, work.mat, work.vec
+    stages, cg, cw, rg = work.stages, work.cg, work.cw, work.rg
     y = stages[ly.STAGE_CUR]
     ym = stages[ly.STAGE_TRY]
     k = stages[ly.STAGE_KTRY]

@@ -108,7 +108,7 @@ def hammer_tip(force_n: float, width_s: float = 1e-3, t_hit_s: float = 0.0) -> n
 @dataclass(frozen=True)
 class Step:
     """A run's step and span, for a drive's check: ``dt`` (s), the run's ``end`` (s),
-    ``strict`` (the command line and studies, :func:`~workbench.model.simulate.check_settings`),
+    ``strict`` (the command line and studies, :func:`~workbench.model.run_settings.check_settings`),
     ``name`` (a setting's name as the user wrote it) and the signals' ``output_hz``."""
 
     dt: float

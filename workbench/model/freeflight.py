@@ -64,5 +64,5 @@ def integrate(model: mdl.Model, y0: np.ndarray, duration: float, dt: float,
     n_out = n_steps // decim + 1
     out_t = np.empty(n_out)
     out_y = np.empty((n_out, ly.N_STATE))
-    status, stored = integrate_fixed(y0, 0.0, dt, n_steps, decim, *model, ex, *work, out_t, out_y)
+    status, stored = integrate_fixed(y0, 0.0, dt, n_steps, decim, model, ex, work, out_t, out_y)
     return Trajectory(out_t[:stored], out_y[:stored], int(status), ly.MESSAGES[int(status)])

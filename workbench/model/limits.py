@@ -3,13 +3,13 @@
 Physical parameters carry their ranges in :mod:`workbench.model.params`; these
 are the settings of a run.  What a given step resolves (drive frequency,
 pulse width) is checked against the step by
-:func:`workbench.model.simulate.check_settings`.
+:func:`workbench.model.run_settings.check_settings`.
 """
 #: The longest run (s) and the shortest step (s).
 MAX_DURATION_S = 1e5
 MIN_DT = 1e-7
 #: The largest step (s): RK4 is unstable far below it for this model; the
-#: model's own limit is :func:`workbench.model.simulate.stability_limit`.
+#: model's own limit is :func:`workbench.model.step_policy.stability_limit`.
 MAX_DT = 1e-3
 #: The controlled method's relative tolerance: its default and allowed range
 #: (docs/model.md "Integration").  The default is the largest of 1e-3, 1e-4,
@@ -42,7 +42,7 @@ DEFAULT_OUTPUT_HZ = 1000.0
 #: The longest study name (it names a folder).
 MAX_NAME_CHARS = 100
 
-#: :func:`workbench.model.simulate.default_dt` asks RK4 to be stable for every eigenvalue of the
+#: :func:`workbench.model.step_policy.default_dt` asks RK4 to be stable for every eigenvalue of the
 #: linear model scaled by this factor: room for the stiffening of contact.
 STABILITY_MARGIN = 1.25
 

@@ -31,7 +31,7 @@ def linear_matrices(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, n
     model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
     work = mdl.make_work()
     zero = np.zeros(ly.N_DOF)
-    eval_inertia(zero, zero, *model, *work)
+    eval_inertia(zero, zero, model, work)
     M = work.mat[ly.MAT_M].copy()
     K = model.kc[ly.KC_K].copy()
     law = p.cork_law
@@ -143,7 +143,7 @@ def linear_eigenvalues(p: Parameters) -> np.ndarray:
     Computed once per parameter set (the array is read-only; a study checks its
     points, then plans them: the cache holds the largest designs' sets).
 
-    They set the explicit integrator's step (:func:`workbench.model.simulate.default_dt`):
+    They set the explicit integrator's step (:func:`workbench.model.step_policy.default_dt`):
     the fastest are the beams' axial modes, damped at their own zeta
     (docs/model.md §5): -246 +- 2.05e4 j 1/s with the tip mass, -321 +- 3.54e4 j
     without.

@@ -85,8 +85,9 @@ class _Statics:
     def newton(self, z, q_base, set_index: int, hold_s: bool) -> bool:
         """Solve the set's equations from z (overwritten); True when converged."""
         coords, points, friction = self.unknowns(set_index, hold_s)
-        status = newton_set(z, q_base, coords, points, friction, self.tip_load, _TOL, _MAX_NEWTON,
-                            _MAX_DAMPED_IN_A_ROW, *self.model, self.ex, *self.work)
+        case = (q_base, coords, points, friction, self.tip_load)
+        status = newton_set(z, case, _TOL, _MAX_NEWTON, _MAX_DAMPED_IN_A_ROW, self.model,
+                            self.ex, self.work)
         return status == ly.EQ_CONVERGED
 
     def state(self, z, q_base, set_index: int, hold_s: bool):
@@ -94,8 +95,8 @@ class _Statics:
         energy (erg) and the tip's height (cm) of unknowns z."""
         coords, points, friction = self.unknowns(set_index, hold_s)
         q, Q, f, energy = np.zeros(ly.N_DOF), np.zeros(ly.N_DOF), np.zeros(z.size), np.zeros(4)
-        static_state(z, q_base, coords, points, friction, self.tip_load, *self.model, self.ex,
-                     *self.work, q, Q, f, energy)
+        static_state(z, (q_base, coords, points, friction, self.tip_load), self.model, self.ex,
+                     self.work, q, Q, f, energy)
         gaps = self.work.cg[ly.CG_G:ly.CG_G + ly.N_POINTS, ly.CG_VAL].copy()
         potential = energy[0] + energy[1] + energy[2] - self.tip_load * energy[3]
         return q, Q, gaps, potential, energy[3]

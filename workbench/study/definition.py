@@ -8,7 +8,7 @@
     tol = 1e-4                       # optional tolerance of the controlled method (the default)
     method = "dop853"                # optional: "dop853", "dopri5" (controlled), or "rk4" (fixed dt)
     dt = 5e-5                        # optional step (s): rk4's fixed step (without tol), or the
-                                     # controlled method's largest; default: simulate.default_dt
+                                     # controlled method's largest; default: step_policy.default_dt
     output_hz = 1000.0               # optional sample rate of the signals (Hz)
     check_accuracy = true            # optional: each point also run at a tenth of tol and half
                                      # the step (a quarter of a fixed dt), its error measured
@@ -210,7 +210,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     if dt is not None:
         dt = check_positive("[study] dt", dt, "s")
     output_hz = check_positive("[study] output_hz", head.get("output_hz", 1000.0), "Hz")
-    from ..model.simulate import check_method
+    from ..model.run_settings import check_method
     tol = head.get("tol")
     if tol is not None and (isinstance(tol, bool) or not isinstance(tol, (int, float))):
         raise StudyError(f"[study] tol = {_short(tol)} must be a number")
@@ -387,7 +387,7 @@ def _value_key(value):
 
 def _check_point(point: Point, duration, dt, output_hz, where) -> None:
     """A point's excitation values, and its run settings against what the step resolves."""
-    from ..model.simulate import check_settings
+    from ..model.run_settings import check_settings
     ex = point.excitation_array()                  # validates the excitation values
     drives.start_keywords(point.excitation, where)
     check_settings(point.params, ex, duration, dt, output_hz, names=where)

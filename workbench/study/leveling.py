@@ -114,7 +114,7 @@ class Leveled:
 
 def level(simulate_at: Callable[..., object], force_max: float, limits: Limits,
           estimate: float | None = None) -> Leveled:
-    """The run (``simulate_at(force, stop=...)``, a :class:`~workbench.model.simulate.Run`) at
+    """The run (``simulate_at(force, stop=...)``, a :class:`~workbench.model.run_result.Run`) at
     the largest force up to ``force_max`` (N) meeting every limit, by the search of the
     module docstring, from ``estimate`` (N) if given."""
     force = force_max if estimate is None or not estimate > 0 else min(force_max, estimate)

@@ -51,7 +51,7 @@ import numpy as np
 from ..model import regimes
 from ..model.regimes import contact_shares_of, regime_time_of
 from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
-from ..model.simulate import CONTACT_STAT_KEYS
+from ..model.run_result import CONTACT_STAT_KEYS
 
 CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
 HARMONICS = (0.5, 1.0, 2.0, 3.0)
@@ -214,7 +214,7 @@ def validity(run) -> dict:
 
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
                   steady_tol: float = STEADY_TOL) -> dict:
-    """The metrics of the module docstring for a finished :class:`~workbench.model.simulate.Run`."""
+    """The metrics of the module docstring for a finished :class:`~workbench.model.run_result.Run`."""
     sig = run.signals
     t = sig.index.to_numpy()
     t_end = float(t[-1])

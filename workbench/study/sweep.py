@@ -38,7 +38,8 @@ from .metrics import contact_checks, point_metrics
 from .provenance import code_version
 from ..model.drives import excitation_array
 from ..model.methods import METHODS
-from ..model.simulate import default_dt, simulate
+from ..model.step_policy import default_dt
+from ..model.simulate import simulate
 from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
 from .definition import Point, Study, load
 
