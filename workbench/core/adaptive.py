@@ -228,36 +228,202 @@ def _earlier_on_steps(e, theta, t, h, model, ex, work):
 
 
 @nb.njit(**JIT)
+def _take_step(stages, ev, last):
+    """An accepted step without an event: its end becomes the current state, its last stage
+    the next step's first (first same as last), its event functions the next start's."""
+    _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+    _copy(stages, last, ly.STAGE_K1)
+    _copy_ev(ev, ly.EV_END, ly.EV_START)
+    for p in range(ly.N_POINTS):
+        ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+
+
+@nb.njit(**JIT)
+def _bad_input(y0, span, tolerance, P, out, log):
+    """Whether run_adaptive's arrays or settings are inconsistent (ERR_BAD_INPUT)."""
+    dt, n_steps, step0, decim = span
+    tol, level_max = tolerance
+    need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
+    return (y0.shape[0] != ly.N_AUG or decim < 1 or out[0].shape[0] < need
+            or out[1].shape[0] < need or out[2].shape[0] < need
+            or log.shape[0] < 2 * LOG_RESERVE or not tol > 0.0 or level_max < 0
+            or P[ly.P_RK_DEGREE] < 1.0)
+
+
+@nb.njit(**JIT)
+def _rejected(status, err, arg, h, h_floor, order, ctl):
+    """Count a rejected step of h (s) and return the step to try next (s): a quarter after
+    a failure, else the controller's decrease, at least h_floor."""
+    ctl[ly.CTL_REJECTED] += 1.0
+    ctl[ly.CTL_WORK] += 1.0
+    if arg >= ly.N_STATE:
+        ctl[ly.CTL_REJECTED_EVENTS] += 1.0
+    if status != ly.OK or not math.isfinite(err):
+        h_new = 0.25 * h
+    else:
+        h_new = h * max(FAC_MIN, SAFETY * err ** (-1.0 / order))
+    return max(h_new, h_floor)
+
+
+@nb.njit(**JIT)
+def _accepted(step, force, tol, before, model, work, control):
+    """The account of an accepted step ``step`` = (t, h, err, arg, dt, e, theta): its
+    statistics, the error scales grown by its state and total normal force (dyn), the
+    event functions' noise levels, and the squared time error of its event e (if any);
+    ``before`` is the regime's (set, stick) before the step."""
+    t, h, err, arg, dt, e, theta = step
+    P, stages, rg, ev = model.P, work.stages, work.rg, work.ev
+    ctl, scale, floor_log = control
+    ctl[ly.CTL_WORK] += 1.0
+    _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, before[0], before[1])
+    grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
+    for k in range(ly.N_EV):
+        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
+    if e >= 0:
+        te = _event_time_error(e, theta * h, ev, stages[ly.STAGE_TMP])
+        ctl[ly.CTL_T_SSQ] += te * te
+
+
+@nb.njit(**JIT)
+def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
+    """A step of the pair of h_try (s) from (t, y) into STAGE_NEXT, its error estimate over
+    the tolerance (q, q', the event functions, the time of the first event it locates) and
+    that event.  Returns (status, err, arg of the largest estimate, the total normal force,
+    the event e (-1: none), its fraction theta of the step)."""
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    status = pair_step(t, y, h_try, model, ex, work, st, stages[ly.STAGE_NEXT])
+    err = np.inf
+    arg = -1
+    force = 0.0
+    if status == ly.OK:
+        event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+        force = total_normal_force(rg)
+        status, err, arg = step_error(tol, model, ex, work, scale, ctl, t + h_try)
+    e = -1
+    theta = 2.0
+    acceptable = err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)
+    if status == ly.OK and acceptable and P[ly.P_RK_EXTRA] > 0.0:
+        status = prepare_dense(t, y, h_try, model, ex, work)
+    if status == ly.OK and acceptable:
+        ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
+        for k in range(ly.N_EV):
+            ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
+        status, e, theta = locate(t, h_try, np.bool_(True), model, ex, work)
+        if status == ly.OK and e >= 0:
+            te = _event_time_error(e, theta * h_try, ev, ev_err)
+            r = te / (tol * EVENT_TIME_SCALE_S)
+            if r > err:
+                err = r
+                arg = ly.N_STATE + ly.N_EV
+    return status, err, arg, force, e, theta
+
+
+@nb.njit(**JIT)
+def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
+    """Store the samples of the lattice (t0, step0, dt, decim, m_stop) in (t, t_end] from the
+    dense output of the step of h (s) from (t, y) (its end from STAGE_NEXT when the step is
+    ``whole``, not cut at an event).  ``counts`` is (stored, b_next); returns (status, stored,
+    b_next)."""
+    t0, step0, dt, decim, m_stop = lattice
+    stored, b_next = counts
+    P, stages = model.P, work.stages
+    out_t, out_y, out_sig = out
+    while b_next <= m_stop:
+        t_sample = t0 + (b_next - step0) * dt
+        if t_sample > t_end + STEP_REMAINDER_REL * dt:
+            break
+        x = (t_sample - t) / h
+        y_s = stages[ly.STAGE_NEXT]
+        if not (whole and x >= 1.0 - 1e-12):
+            y_s = stages[ly.STAGE_HI]
+            dense(min(x, 1.0), h, y, P, stages, y_s)
+        status = store(stored, t_sample, y_s, model, ex, work, st, out_t, out_y, out_sig)
+        if status != ly.OK:
+            return status, stored, b_next
+        stored += 1
+        b_next += decim
+    return ly.OK, stored, b_next
+
+
+@nb.njit(**JIT)
+def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
+    """After a step of h (s) from (t, y) in which event e was located at theta: one step of
+    the pair from the step's start to just past it, then the event and any impact it sets
+    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log)."""
+    stages, rg, ev = work.stages, work.rg, work.ev
+    status, theta = _step_past(e, theta, t, h, model, ex, work, st)
+    if status == ly.OK:
+        status, e, theta = _earlier_on_steps(e, theta, t, h, model, ex, work)
+    if status != ly.OK:
+        st[ly.ST_T] = t
+        return status, t, n_log
+    _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
+    if theta < 1.0:
+        t = t + theta * h
+    else:
+        t = t_stop if h == t_stop - t else t + h
+    penetration(st, rg, ev, ly.EV_HI, t, 10)    # when the event is found
+    n_step_events = 0
+    while e >= 0:
+        n_step_events += 1
+        if flooding(st, t) or n_step_events > MAX_EVENTS_PER_STEP:
+            st[ly.ST_STEPPED_UNTIL] = t + STEPPED_TIME_S
+            return rhs_regime(t, y, model, ex, work, stages[ly.STAGE_K1]), t, n_log
+        status = apply_event(e, t, model, ex, work, log, n_log, st)
+        if status != ly.OK:
+            st[ly.ST_T] = t
+            return status, t, n_log
+        n_log += 1
+        e = _immediate_impact(ev)
+    return ly.OK, t, n_log
+
+
+@nb.njit(**JIT)
+def _stepped_span(t, t_stop, y, lattice, counts, model, ex, work, st, out):
+    """Moreau-Jean steps from t to the end of the flood's interval (ST_STEPPED_UNTIL), t_stop
+    or the next sample of the lattice (t0, step0, dt, decim, m_stop), whichever comes first,
+    and that sample.  ``counts`` is (stored, b_next); returns (status, t, stored, b_next)."""
+    t0, step0, dt, decim, m_stop = lattice
+    stored, b_next = counts
+    out_t, out_y, out_sig = out
+    t_sample = t0 + (b_next - step0) * dt
+    t_next = min(st[ly.ST_STEPPED_UNTIL], t_stop)
+    if b_next <= m_stop:
+        t_next = min(t_next, t_sample)
+    status = _stepped(t, t_next - t, model, ex, work, st)
+    if status != ly.OK:
+        st[ly.ST_T] = t
+        return status, t, stored, b_next
+    t = t_next
+    if b_next <= m_stop and t >= t_sample - STEP_REMAINDER_REL * dt:
+        status = store(stored, t_sample, y, model, ex, work, st, out_t, out_y, out_sig)
+        if status != ly.OK:
+            return status, t, stored, b_next
+        stored += 1
+        b_next += decim
+    return ly.OK, t, stored, b_next
+
+
+@nb.njit(**JIT)
 def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control):
     """Integrate n_steps base steps dt (s) from (t0, y0) with steps chosen by the error.
 
-    ``span`` is (dt, n_steps, step0, decim), ``tolerance`` (tol, level_max).  The arrays
-    come in named groups: ``model`` (P, tab, kc, free) and
-    ``work`` (rec, mat, vec, stages, cg, cw, rg, ev), as
-    :mod:`workbench.model.packing` builds them; ``out`` (out_t, out_y,
-    out_sig), the samples; ``control`` (ctl, scale, floor_log), the
-    controller's state.
-    As :func:`workbench.core.hybrid.run_hybrid` (chunks by ``step0``; a
-    sample at every base step b, counted from the run's start, with
-    b % decim == 0, here the dense output there; LOG_FULL at a base step
-    when the log runs short), with steps of the pair in P chosen against
-    the relative tolerance ``tol`` > 0, between dt and dt / 2^level_max
-    (module docstring).  ``ctl`` (N_CTL,), ``scale`` (N_SCALE_ROWS,
-    N_STATE) and ``floor_log`` (capacity, N_FLOOR) carry the controller
-    between calls (zeros, with CTL_H_MIN = inf, before the first).
+    ``span`` (dt, n_steps, step0, decim) and the groups ``model``, ``work``, ``out`` as
+    :func:`workbench.core.hybrid.run_hybrid` (samples here from the dense output);
+    ``tolerance`` is (tol, level_max): steps of the pair in P against the relative
+    tolerance tol > 0, between dt and dt / 2^level_max (module docstring); ``control``
+    (ctl (N_CTL,), scale (N_SCALE_ROWS, N_STATE), floor_log (capacity, N_FLOOR)) carries
+    the controller between calls (zeros, with CTL_H_MIN = inf, before the first).
     Returns ``(status, n_stored, n_log)``.
     """
     dt, n_steps, step0, decim = span
     tol, level_max = tolerance
-    P, tab, kc, free = model
-    rec, mat, vec, stages, cg, cw, rg, ev = work
+    P = model.P
+    stages, rg, ev = work.stages, work.rg, work.ev
     out_t, out_y, out_sig = out
-    ctl, scale, floor_log = control
-    n_out = out_t.shape[0]
-    need = (step0 + n_steps) // decim - step0 // decim + (1 if step0 == 0 else 0)
-    if (y0.shape[0] != ly.N_AUG or decim < 1 or n_out < need or out_y.shape[0] < need
-            or out_sig.shape[0] < need or log.shape[0] < 2 * LOG_RESERVE
-            or not tol > 0.0 or level_max < 0 or P[ly.P_RK_DEGREE] < 1.0):
+    ctl, scale = control[0], control[1]
+    if _bad_input(y0, span, tolerance, P, out, log):
         return ly.ERR_BAD_INPUT, 0, 0
     y = stages[ly.STAGE_CUR]
     for i in range(ly.N_AUG):
@@ -269,8 +435,8 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     last = int(P[ly.P_RK_STAGES]) - 1
     floors(P, scale)
     grow_scales(y, total_normal_force(rg), scale, ctl)
-    for e in range(ly.N_EV):
-        ev[ly.EV_NOISE, e] = tol * event_scale(e, P, scale, ctl)
+    for k in range(ly.N_EV):
+        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
     h_floor = dt / (1 << level_max)
     h_max = max(P[ly.P_RK_STEP_FACTOR], 1.0) * dt
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
@@ -291,133 +457,45 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         if n_log + MAX_EVENTS_PER_STEP + 2 > log.shape[0]:
             st[ly.ST_T] = t
             return ly.ERR_EVENT_FLOOD, stored, n_log
-        t_sample = t0 + (b_next - step0) * dt
         if st[ly.ST_STEPPED_UNTIL] > t + STEP_REMAINDER_REL * dt:
             # Moreau-Jean time-stepping after an event flood
-            t_next = min(st[ly.ST_STEPPED_UNTIL], t_stop)
-            if b_next <= m_stop:
-                t_next = min(t_next, t_sample)
-            status = _stepped(t, t_next - t, model, ex, work, st)
+            status, t, stored, b_next = _stepped_span(t, t_stop, y, (t0, step0, dt, decim, m_stop),
+                                                      (stored, b_next), model, ex, work, st, out)
             if status != ly.OK:
-                st[ly.ST_T] = t
                 return status, stored, n_log
-            t = t_next
-            if b_next <= m_stop and t >= t_sample - STEP_REMAINDER_REL * dt:
-                status = store(stored, t_sample, y, model, ex, work, st, out_t, out_y, out_sig)
-                if status != ly.OK:
-                    return status, stored, n_log
-                stored += 1
-                b_next += decim
             continue
         h_try = min(h, h_max, t_stop - t)
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
-        status = pair_step(t, y, h_try, model, ex, work, st, stages[ly.STAGE_NEXT])
-        err = np.inf
-        arg = -1
-        force = 0.0
-        if status == ly.OK:
-            event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-            force = total_normal_force(rg)
-            status, err, arg = step_error(tol, model, ex, work, scale, ctl, t + h_try)
-        e = -1
-        theta = 2.0
-        if (status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9))
-                and P[ly.P_RK_EXTRA] > 0.0):
-            status = prepare_dense(t, y, h_try, model, ex, work)
-        if status == ly.OK and (err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)):
-            ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
-            for k in range(ly.N_EV):
-                ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
-            status, e, theta = locate(t, h_try, np.bool_(True), model, ex, work)
-            if status == ly.OK and e >= 0:
-                te = _event_time_error(e, theta * h_try, ev, ev_err)
-                r = te / (tol * EVENT_TIME_SCALE_S)
-                if r > err:
-                    err = r
-                    arg = ly.N_STATE + ly.N_EV
+        status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
+                                                      st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
-            ctl[ly.CTL_REJECTED] += 1.0
-            ctl[ly.CTL_WORK] += 1.0
-            if arg >= ly.N_STATE:
-                ctl[ly.CTL_REJECTED_EVENTS] += 1.0
-            if status != ly.OK or not math.isfinite(err):
-                h = 0.25 * h_try
-            else:
-                h = h_try * max(FAC_MIN, SAFETY * err ** (-1.0 / order))
-            h = max(h, h_floor)
+            h = _rejected(status, err, arg, h_try, h_floor, order, ctl)
             rejected = True
             continue
         if status != ly.OK:
             st[ly.ST_T] = t
             return status, stored, n_log
-        ctl[ly.CTL_WORK] += 1.0
-        _record_step(t, h_try, err, arg, dt, stages, rg, scale, ctl, floor_log, set_before,
-                     stick_before)
-        grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
-        for k in range(ly.N_EV):
-            ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
-        if e >= 0:
-            te = _event_time_error(e, theta * h_try, ev, stages[ly.STAGE_TMP])
-            ctl[ly.CTL_T_SSQ] += te * te
+        _accepted((t, h_try, err, arg, dt, e, theta), force, tol, (set_before, stick_before),
+                  model, work, control)
         t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
         if e < 0 and h_try == t_stop - t:
             t_end = t_stop
         # samples in (t, t_end]: the dense output of this step (or its end)
-        while b_next <= m_stop:
-            t_sample = t0 + (b_next - step0) * dt
-            if t_sample > t_end + STEP_REMAINDER_REL * dt:
-                break
-            x = (t_sample - t) / h_try
-            y_s = stages[ly.STAGE_NEXT]
-            if not (e < 0 and x >= 1.0 - 1e-12):
-                y_s = stages[ly.STAGE_HI]
-                dense(min(x, 1.0), h_try, y, P, stages, y_s)
-            status = store(stored, t_sample, y_s, model, ex, work, st, out_t, out_y, out_sig)
-            if status != ly.OK:
-                return status, stored, n_log
-            stored += 1
-            b_next += decim
+        status, stored, b_next = _samples(t, t_end, h_try, e < 0, y, (t0, step0, dt, decim, m_stop),
+                                          (stored, b_next), model, ex, work, st, out)
+        if status != ly.OK:
+            return status, stored, n_log
         if e < 0:
-            _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
-            _copy(stages, last, ly.STAGE_K1)
-            _copy_ev(ev, ly.EV_END, ly.EV_START)
-            for p in range(ly.N_POINTS):
-                ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+            _take_step(stages, ev, last)
             t = t_end
         else:
-            # one step of the pair from the step's start to the event
-            status, theta = _step_past(e, theta, t, h_try, model, ex, work, st)
-            if status == ly.OK:
-                status, e, theta = _earlier_on_steps(e, theta, t, h_try, model, ex, work)
+            status, t, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work, log,
+                                         n_log, st)
             if status != ly.OK:
-                st[ly.ST_T] = t
                 return status, stored, n_log
-            _copy(stages, ly.STAGE_HI, ly.STAGE_CUR)
-            if theta < 1.0:
-                t = t + theta * h_try
-            else:
-                t = t_stop if h_try == t_stop - t else t + h_try
-            penetration(st, rg, ev, ly.EV_HI, t, 10)    # when the event is found
-            n_step_events = 0
-            while e >= 0:
-                n_step_events += 1
-                if flooding(st, t) or n_step_events > MAX_EVENTS_PER_STEP:
-                    st[ly.ST_STEPPED_UNTIL] = t + STEPPED_TIME_S
-                    status = rhs_regime(t, y, model, ex, work, stages[ly.STAGE_K1])
-                    if status != ly.OK:
-                        return status, stored, n_log
-                    break
-                status = apply_event(e, t, model, ex, work, log, n_log, st)
-                if status != ly.OK:
-                    st[ly.ST_T] = t
-                    return status, stored, n_log
-                n_log += 1
-                e = _immediate_impact(ev)
-        if err <= 1.0:
-            h = _next_step(h_try, err, err_prev, order)
-            if rejected:                     # no growth right after a rejection
-                h = min(h, h_try)
+        if err <= 1.0:                       # no growth right after a rejection
+            h = min(_next_step(h_try, err, err_prev, order), h_try if rejected else np.inf)
             err_prev = max(err, ERR_PREV_START)
         rejected = False
         h = max(h, h_floor)

@@ -52,6 +52,18 @@ def _mode_of(combo, i):
     return (STICK, SLIP_POS, SLIP_NEG, OPEN)[code]
 
 
+@nb.njit(**JIT_INLINE)
+def _inside(lo, hi):
+    """The middle of [lo, hi], or where unbounded the point of the interval nearest 0."""
+    if lo > -1e299 and hi < 1e299:
+        return 0.5 * (lo + hi)
+    if lo > -1e299:
+        return max(lo, 0.0)
+    if hi < 1e299:
+        return min(hi, 0.0)
+    return 0.0
+
+
 @nb.njit(**JIT)
 def _combo_impulse(G, u, mu, m, modes, lw, P):
     """Impulses P (2m) of one mode combination that satisfy every condition, if any.
@@ -144,13 +156,7 @@ def _combo_impulse(G, u, mu, m, modes, lw, P):
             lo, hi = _clip(s * ut0 + tol_u, s * ut1, ut1_abs, lo, hi)
     if lo > hi:
         return False
-    alpha = 0.0
-    if lo > -1e299 and hi < 1e299:
-        alpha = 0.5 * (lo + hi)
-    elif lo > -1e299:
-        alpha = max(lo, 0.0)
-    elif hi < 1e299:
-        alpha = min(hi, 0.0)
+    alpha = _inside(lo, hi)
     for r in range(2 * m):
         P[r] = P0[r] + alpha * dP[r]
     return True

@@ -186,6 +186,52 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         if table in data and not isinstance(data[table], dict):
             raise StudyError(f"[{table}] must be a table of keys, got {_short(data[table])}")
     head = dict(data.get("study", {}))
+    run = _run_settings(head)
+    exc = dict(data.get("excitation", {"drive": "none"}))
+    drive = exc.pop("drive", None)
+    if not isinstance(drive, str) or drive not in drives.DRIVES:
+        raise StudyError(f"[excitation] drive = {drive!r}; allowed: {sorted(drives.DRIVES)}")
+    fixed = dict(data.get("fixed", {}))
+    axes = dict(data.get("axes", {}))
+    sample = None
+    if "sample" in data or "ranges" in data:
+        if axes:
+            raise StudyError("a study has [axes] (a grid) or [sample] with [ranges] (a design), "
+                             "not both")
+        if "sample" not in data:
+            raise StudyError("[ranges] needs a [sample] table (n, seed) to draw the design")
+        if run["sweep"] != "independent":
+            raise StudyError(f"[study] sweep = {run['sweep']!r} steps a grid's frequency axis; "
+                             "a [sample] design runs independent points")
+        sample = sensitivity.parse(data["sample"], data.get("ranges", {}), StudyError)
+    _check_axes(axes)
+    inputs = {} if sample is None else {k: None for k in [*sample.names, *sample.same]}
+    _check_keys(drive, exc, fixed, axes, inputs)
+    limits = _limits(data["limits"]) if "limits" in data else None
+    if limits is not None and "force_n" not in drives.DRIVES[drive].keys:
+        raise StudyError(f"[limits] sets each point's force: a {drive!r} excitation has no "
+                         "force_n")
+    frequency = drives.DRIVES[drive].frequency_key
+    sweep = run["sweep"]
+    if sweep != "independent" and (frequency is None or frequency not in axes):
+        raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a drive "
+                         "with a forcing frequency (a sine) with that frequency in [axes]")
+    points = _grid_points(drive, exc, fixed, axes, sample, inputs, run)
+    if sweep != "independent":
+        points = _frequency_chains(points, sweep)
+    elif limits is not None and frequency is not None and frequency in axes:
+        points = _frequency_chains(points, "up", direction="")
+    else:
+        points = [Point(p.values, p.params, p.excitation, chain=i) for i, p in enumerate(points)]
+    series = _save_series(head.get("save_series", []), set(axes) | set(drives.DRIVES[drive].keys))
+    return Study(**run, excitation={"drive": drive, **exc}, fixed=fixed, axes=axes,
+                 save_series=series, source=source, points=tuple(points), limits=limits,
+                 sample=sample)
+
+
+def _run_settings(head: dict) -> dict:
+    """The [study] table's run settings, checked: Study's name, description, duration_s,
+    window_s, sweep, dt, output_hz, method, tol, check_accuracy and initial."""
     bad = sorted(set(head) - STUDY_KEYS)
     if bad:
         raise StudyError(f"unknown key(s) {bad} in [study]; allowed: {sorted(STUDY_KEYS)}")
@@ -229,23 +275,14 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     if initial not in ("static", "paper"):
         raise StudyError(f"[study] initial = {initial!r}; allowed: 'static', 'paper'")
 
-    exc = dict(data.get("excitation", {"drive": "none"}))
-    drive = exc.pop("drive", None)
-    if not isinstance(drive, str) or drive not in drives.DRIVES:
-        raise StudyError(f"[excitation] drive = {drive!r}; allowed: {sorted(drives.DRIVES)}")
-    fixed = dict(data.get("fixed", {}))
-    axes = dict(data.get("axes", {}))
-    sample = None
-    if "sample" in data or "ranges" in data:
-        if axes:
-            raise StudyError("a study has [axes] (a grid) or [sample] with [ranges] (a design), "
-                             "not both")
-        if "sample" not in data:
-            raise StudyError("[ranges] needs a [sample] table (n, seed) to draw the design")
-        if sweep != "independent":
-            raise StudyError(f"[study] sweep = {sweep!r} steps a grid's frequency axis; a "
-                             "[sample] design runs independent points")
-        sample = sensitivity.parse(data["sample"], data.get("ranges", {}), StudyError)
+    return {"name": name, "description": str(head.get("description", "")),
+            "duration_s": duration, "window_s": window, "sweep": sweep, "dt": dt,
+            "output_hz": output_hz, "method": method, "tol": tol,
+            "check_accuracy": check_accuracy, "initial": initial}
+
+
+def _check_axes(axes: dict) -> None:
+    """Each axis a non-empty list of distinct numbers, booleans or strings."""
     for key, values in axes.items():
         if not isinstance(values, list) or not values:
             raise StudyError(f"[axes] {key} must be a non-empty list of values, got {_short(values)}")
@@ -255,13 +292,17 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                                  f"string, got {_short(v)}")
         if len(set(map(_value_key, values))) != len(values):
             raise StudyError(f"[axes] {key} lists a value twice: {_short(values)}")
+
+
+def _check_keys(drive: str, exc: dict, fixed: dict, axes: dict, inputs: dict) -> None:
+    """Every key of [excitation], [fixed], [axes] and [ranges] a setting of the drive or a
+    model parameter, given once, and every setting the drive needs given."""
     allowed_exc = set(drives.DRIVES[drive].keys)
     for key, value in list(exc.items()) + list(fixed.items()):
         if not isinstance(value, (bool, int, float, str)):
             table = "excitation" if key in exc else "fixed"
             raise StudyError(f"[{table}] {key} must be a number, true/false or a string, "
                              f"got {_short(value)}")
-    inputs = {} if sample is None else {k: None for k in [*sample.names, *sample.same]}
     for table, keys in (("excitation", exc), ("axes", axes), ("fixed", fixed),
                         ("ranges", inputs)):
         for key in keys:
@@ -284,16 +325,12 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
                      if drives.DRIVES[drive].default(k) is None)
     if missing:
         raise StudyError(f"a {drive!r} excitation needs {missing} in [excitation] or [axes]")
-    limits = _limits(data["limits"]) if "limits" in data else None
-    if limits is not None and "force_n" not in drives.DRIVES[drive].keys:
-        raise StudyError(f"[limits] sets each point's force: a {drive!r} excitation has no "
-                         "force_n")
-    frequency = drives.DRIVES[drive].frequency_key
-    if sweep != "independent" and (frequency is None or frequency not in axes):
-        raise StudyError(f"[study] sweep = {sweep!r} steps the drive frequency: it needs a drive "
-                         "with a forcing frequency (a sine) with that frequency in [axes]")
 
-    names = list(axes)
+
+def _grid_points(drive, exc, fixed, axes, sample, inputs, run) -> list[Point]:
+    """The grid's (or the design's) points, each checked against what its step resolves."""
+    duration, dt, output_hz = run["duration_s"], run["dt"], run["output_hz"]
+    allowed_exc = set(drives.DRIVES[drive].keys)
     where = {"duration": "[study] duration_s", "dt": "[study] dt", "output_hz": "[study] output_hz"}
     for k in allowed_exc:
         where[k] = f"[{'axes' if k in axes else 'ranges' if k in inputs else 'excitation'}] {k}"
@@ -319,26 +356,20 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
             at = f" (at {_short(values)})" if values else ""
             raise StudyError(f"{exc_}{at}") from None
         points.append(pt)
-    if sweep != "independent":
-        points = _frequency_chains(points, sweep)
-    elif limits is not None and frequency is not None and frequency in axes:
-        points = _frequency_chains(points, "up", direction="")
-    else:
-        points = [Point(p.values, p.params, p.excitation, chain=i) for i, p in enumerate(points)]
-    raw = head.get("save_series", [])
+    return points
+
+
+def _save_series(raw, selectable: set) -> tuple:
+    """[study] save_series: selectors of points by axis (or drive setting) values."""
     if not isinstance(raw, list) or not all(isinstance(sel, dict) for sel in raw):
         raise StudyError("[study] save_series must be a list of tables such as "
                          f"[{{gap_mm = 1.016}}], got {_short(raw)}")
     series = tuple(dict(s) for s in raw)
     for sel in series:
-        bad = sorted(set(sel) - set(names) - set(allowed_exc))
+        bad = sorted(set(sel) - selectable)
         if bad:
             raise StudyError(f"[study] save_series selects by {bad}, which are not axes")
-    return Study(name=name, description=str(head.get("description", "")), duration_s=duration,
-                 window_s=window, sweep=sweep, dt=dt, output_hz=output_hz, initial=initial,
-                 excitation={"drive": drive, **exc}, fixed=fixed, axes=axes, save_series=series,
-                 source=source, points=tuple(points), method=method, tol=tol,
-                 limits=limits, check_accuracy=check_accuracy, sample=sample)
+    return series
 
 
 def _combinations(axes: dict, sample) -> list[tuple[dict, dict]]:
