@@ -4,9 +4,11 @@
 standard library, never pandas, matplotlib, joblib or the rest of the
 package; every jit decorator takes its options from ``core/config.py``
 (``JIT``, ``JIT_INLINE``, ``JIT_ALLOC`` for the two kernels that allocate,
-``JIT_PARALLEL``: ``cache=True`` and the error model in one place); and the work arrays come in one order everywhere, that of
-:class:`workbench.model.packing.Work` after the model's arrays, so a
-swapped pair (all are 2-D float arrays) cannot compile silently.
+``JIT_PARALLEL``: ``cache=True`` and the error model in one place); the arrays come in one
+order everywhere: the model's (the group ``model`` or its fields), the drive ``ex``, the
+work's (the group ``work`` or the fields of :class:`workbench.model.packing.Work`), so a
+swapped pair (all are 2-D float arrays) cannot compile silently; and no kernel takes more
+than MAX_ARGUMENTS positional arguments (the arrays travel in named groups).
 """
 from __future__ import annotations
 
@@ -29,7 +31,9 @@ ALLOWED_IMPORTS = {"numba", "numpy", "math", "__future__", "hashlib", "os", "shu
 ALLOCATING = {"np.zeros", "np.empty", "np.ones", "np.full", "np.array", "np.copy",
               "np.concatenate", "np.zeros_like", "np.empty_like"}
 #: The one order of the arrays a kernel takes: the model's, the drive, the work's.
-ARGUMENT_ORDER = [*Model._fields, "ex", *Work._fields]
+ARGUMENT_ORDER = ["model", *Model._fields, "ex", "work", *Work._fields]
+#: The most positional arguments a kernel takes.
+MAX_ARGUMENTS = 12
 
 
 def _tree(path):
@@ -93,3 +97,11 @@ def test_the_kernels_take_their_arrays_in_one_order():
             assert positions == sorted(positions), (f"{path.name}:{node.name} takes {names}; "
                                                     f"the order is {ARGUMENT_ORDER}")
     assert checked > 30
+
+
+def test_no_kernel_takes_more_than_a_dozen_arguments():
+    wide = [f"{path.name}:{node.name} ({len(node.args.args)})" for path in SOURCES
+            for node in ast.walk(_tree(path))
+            if isinstance(node, ast.FunctionDef) and len(node.args.args) > MAX_ARGUMENTS
+            and any("jit" in ast.unparse(d) for d in node.decorator_list)]
+    assert not wide, wide
