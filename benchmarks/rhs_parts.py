@@ -32,7 +32,7 @@ RHS, RHS_REGIME = 3, 4              # the indices of the whole right-hand sides 
 
 # Not cached: numba's cache=True checks only this file's timestamp, so a
 # cached loop would keep the machine code of kernels edited since
-# (workbench/core/_cache.py keys only the kernels of workbench.core).
+# (workbench/core/compiler/cache.py keys only the kernels of workbench.core).
 @nb.njit
 def repeat(which, n, y, model, ex, work, ydot):
     P, tab, kc, free = model

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pytest
 
-from workbench.core._cache import index_entries
+from workbench.core.compiler.cache import index_entries
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMAND = ["-m", "workbench", "run", "--gap-mm", "1.016", "--tip-mass", "on", "--cork", "cubic",

@@ -62,7 +62,7 @@ def pytest_sessionfinish(session, exitstatus):
     (a literal or omitted argument, or a test passing other types;
     tests/core/test_compile.py): in this process, and when the suite ran in
     worker processes (``pytest -n``), in the cache they all wrote."""
-    from workbench.core._cache import index_entries, kernel_versions
+    from workbench.core.compiler.cache import index_entries, kernel_versions
     extra = {k: n for k, n in kernel_versions().items() if n > 1}
     if not hasattr(session.config, "workerinput"):          # not a worker: the whole run
         extra.update({k: n for k, n in index_entries().items() if n > 1})

@@ -1,4 +1,4 @@
-"""Inlining this package's helpers at less cost (workbench/core/_inlining.py).
+"""Inlining this package's helpers at less cost (workbench/core/compiler/inlining.py).
 
 numba's untyped pipeline runs once per helper, not once per call site; the
 kept IR is never changed by an inlining; and a caller computes what it
@@ -11,9 +11,14 @@ import numpy as np
 import pytest
 from numba.core import inline_closurecall
 
-from workbench.core import _inlining, layout as ly
+from workbench.core import layout as ly
+from workbench.core.compiler import inlining as _inlining
 from workbench.core.constrained import kinetic_energy
 from workbench.core.hybrid import _hermite_min
+
+from workbench.core import compiler
+
+pytestmark = pytest.mark.skipif(not compiler.active(), reason="the compiler's workarounds are off")
 
 
 def _callers():

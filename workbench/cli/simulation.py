@@ -35,15 +35,17 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_compile(args) -> int:
-    from ..core._cache import CACHE_DIR
+    from ..core.compiler.cache import CACHE_DIR
     from ..model.compile_plan import compile_parallel, load_plan, usable_cores
     from ..model.warmup import compile_all
     jobs = args.jobs or usable_cores()
     print(f"workbench: compiling the numba kernels into {CACHE_DIR} ({jobs} processes)",
           file=sys.stderr, flush=True)
     t0 = time.perf_counter()
-    errors = compile_parallel(None, jobs)
-    print(f"  {len(load_plan())} kernels of the plan: {time.perf_counter() - t0:.0f} s")
+    from ..core import compiler
+    errors = compile_parallel(None, jobs) if compiler.active() else []
+    if compiler.active():
+        print(f"  {len(load_plan())} kernels of the plan: {time.perf_counter() - t0:.0f} s")
     for error in errors:
         print(f"  FAILED: {error}")
     for name, seconds, error in compile_all(jobs):

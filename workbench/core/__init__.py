@@ -2,11 +2,10 @@
 
 Nothing in this package imports pandas, matplotlib or joblib, allocates in a
 hot loop, or raises; the Python layer around it validates, converts units,
-allocates and builds tables.
+allocates and builds tables.  The compiler's workarounds are the subpackage
+:mod:`.compiler`, installed here before any kernel is defined.
 """
 
-from . import _cache, _inlining, _linking
+from . import compiler
 
-_cache.install()   # before any kernel is defined: see _cache for why
-_linking.install()
-_inlining.install()
+compiler.install()

@@ -98,7 +98,7 @@ def chain_seconds(plan: dict) -> dict:
 
 def missing(plan: dict) -> list[str]:
     """The plan's kernels without an entry in numba's cache folder."""
-    from ..core._cache import CACHE_DIR
+    from ..core.compiler.cache import CACHE_DIR
     return [name for name in plan if not any(CACHE_DIR.glob(f"{name}-*.nbi"))]
 
 
@@ -110,7 +110,7 @@ def _compile(name: str, signature) -> None:
 
 
 def eval_type(text: str):
-    """A numba type from its name in the plan (workbench.core._linking.type_name)."""
+    """A numba type from its name in the plan (workbench.core.compiler.linking.type_name)."""
     import importlib
     import numba
     namespace = dict(vars(numba.types))
@@ -224,7 +224,7 @@ ev.register("numba:compile", _Listener())
 #: Prints the kernels of this process: signature, links and own compile time.
 _RECORD = """
 import json
-from workbench.core._linking import kernel_graph
+from workbench.core.compiler.linking import kernel_graph
 print(json.dumps({name: dict(entry, seconds=round(_own.get(name, 0.0), 2))
                   for name, entry in kernel_graph().items()}))
 """

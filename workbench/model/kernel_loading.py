@@ -72,16 +72,18 @@ def kernel_name(kernel) -> str:
 def prepare_kernels(kernel) -> None:
     """Before a process's first run of ``kernel``: when numba's cache lacks any of
     the run's kernels, compile them in parallel on the usable cores
-    (:mod:`~workbench.model.compile_plan`), saying so on stderr first.  The
+    (:mod:`~workbench.model.compile_plan`), saying so on stderr first (with the
+    compiler's workarounds off, :mod:`workbench.core.compiler`, on first use instead).  The
     first run of ``kernel`` reports the seconds in its ``compile_s``.
     """
     if not hasattr(kernel, "signatures") or kernel_name(kernel) in _prepared:
         return                                      # NUMBA_DISABLE_JIT, or done
     from . import compile_plan
-    from ..core._cache import CACHE_DIR
+    from ..core import compiler
+    from ..core.compiler.cache import CACHE_DIR
     _prepared.add(kernel_name(kernel))
     roots = (kernel_name(kernel), *_RUN_KERNELS)
-    jobs = compile_plan.jobs_from_environment()
+    jobs = compile_plan.jobs_from_environment() if compiler.active() else 0
     if jobs == 0:
         if not first_use:
             first_use.append(FirstUseClock().register())

@@ -20,6 +20,7 @@ the kernels (a user's ``njit(cache=True)`` function, say).
 """
 from __future__ import annotations
 
+
 import importlib
 import sys
 
@@ -27,6 +28,9 @@ import llvmlite.binding as ll
 import numba as nb
 from numba.core import caching, codegen
 from numba.core.registry import CPUDispatcher
+
+#: The package of the kernels.
+_CORE_PACKAGE = __package__.rsplit(".", 1)[0]
 
 #: Marks the mangled names of this package's functions (and their wrappers).
 _MARK = "9workbench4core"
@@ -73,13 +77,13 @@ def _finalize(self):
 
 
 def _is_ours(cache_impl) -> bool:
-    from ._cache import _KernelCacheLocator
-    return isinstance(cache_impl._locator, _KernelCacheLocator)
+    from .cache import kernel_locator
+    return isinstance(cache_impl._locator, kernel_locator())
 
 
 def _dispatchers():
     for name, module in list(sys.modules.items()):
-        if name.startswith(__package__ + ".") and module is not None:
+        if name.startswith(_CORE_PACKAGE + ".") and module is not None:
             for attr, obj in vars(module).items():
                 if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == name:
                     yield name, attr, obj

@@ -28,10 +28,12 @@ import shutil
 import time
 from pathlib import Path
 
-from numba.core import caching
-
-_CORE = Path(__file__).resolve().parent
-_SOURCES = sorted(_CORE.glob("*.py"))           # the kernels and their config.py
+_CORE = Path(__file__).resolve().parents[1]
+#: The kernels and their config.py, and this package's workarounds (they shape the code).
+_KERNELS = sorted(_CORE.glob("*.py"))
+_SOURCES = _KERNELS + sorted(Path(__file__).parent.glob("*.py"))
+#: The package of the kernels.
+CORE_PACKAGE = __package__.rsplit(".", 1)[0]
 _PREFIX = "numba-"
 
 #: A cache folder of another version unused this long (days) is removed.
@@ -47,30 +49,60 @@ def source_hash() -> str:
     return h.hexdigest()[:16]
 
 
+def _folder() -> str:
+    """numba-<hash>, or numba-<hash>-plain for kernels compiled without the workarounds."""
+    from . import active
+    return _PREFIX + source_hash() + ("" if active() else "-plain")
+
+
 CACHE_ROOT = Path(os.environ.get("WORKBENCH_CACHE_ROOT") or _CORE / "__pycache__")
-CACHE_DIR = CACHE_ROOT / (_PREFIX + source_hash())
+CACHE_DIR = CACHE_ROOT / _folder()
+_LOCATOR: list = []
 
 
-class _KernelCacheLocator(caching.InTreeCacheLocator):
-    """Cache files of workbench.core in CACHE_DIR; other functions are not ours."""
+def kernel_locator():
+    """The cache locator class of the kernels (built on first use: it subclasses numba's
+    private ``InTreeCacheLocator``)."""
+    if _LOCATOR:
+        return _LOCATOR[0]
+    from numba.core import caching
 
-    def __init__(self, py_func, py_file):
-        super().__init__(py_func, py_file)
-        self._cache_path = str(CACHE_DIR)
+    class KernelCacheLocator(caching.InTreeCacheLocator):
+        """Cache files of workbench.core in CACHE_DIR; other functions are not ours."""
 
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        if Path(py_file).resolve().parent != _CORE:
-            return None
-        return super().from_function(py_func, py_file)
+        def __init__(self, py_func, py_file):
+            super().__init__(py_func, py_file)
+            self._cache_path = str(CACHE_DIR)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if Path(py_file).resolve().parent != _CORE:
+                return None
+            return super().from_function(py_func, py_file)
+    _LOCATOR.append(KernelCacheLocator)
+    return KernelCacheLocator
 
 
 def install() -> None:
-    """Put the locator first in numba's list, mark this version's folder as
-    used, and prune folders of other versions unused for PRUNE_AFTER_DAYS."""
+    """Put the locator first in numba's list, then :func:`keep`."""
+    from numba.core import caching
     locators = caching.CacheImpl._locator_classes
-    if _KernelCacheLocator not in locators:
-        locators.insert(0, _KernelCacheLocator)
+    if kernel_locator() not in locators:
+        locators.insert(0, kernel_locator())
+    keep()
+
+
+def use_plain() -> None:
+    """Without the workarounds: numba's own locator for a user's cache folder
+    (``numba.config.CACHE_DIR``, public), set to CACHE_DIR, then :func:`keep`."""
+    import numba
+    numba.config.CACHE_DIR = str(CACHE_DIR)
+    keep()
+
+
+def keep() -> None:
+    """Mark this version's folder as used, and prune folders of other versions unused for
+    PRUNE_AFTER_DAYS."""
     if not CACHE_ROOT.is_dir():
         return
     try:
@@ -110,8 +142,8 @@ def kernel_versions() -> dict:
     import importlib
     from numba.core.registry import CPUDispatcher
     out = {}
-    for path in _SOURCES:
-        module = importlib.import_module(f"{__package__}.{path.stem}")
+    for path in _KERNELS:
+        module = importlib.import_module(f"{CORE_PACKAGE}.{path.stem}")
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
                     and obj.signatures:

@@ -25,6 +25,9 @@ import copy
 
 from numba.core import inline_closurecall, ir
 
+#: The package of the kernels.
+_CORE_PACKAGE = __package__.rsplit(".", 1)[0]
+
 _numba_inline_function = inline_closurecall.InlineWorker.inline_function
 
 #: (helper's Python function, enable_ssa, no_rewrites) -> its untyped numba IR.
@@ -59,7 +62,7 @@ def _untyped_ir(worker, func):
 
 def _inline_function(self, caller_ir, block, i, function, arg_typs=None):
     """numba's ``InlineWorker.inline_function``, for this package's helpers at less cost."""
-    if not getattr(function, "__module__", "").startswith(__package__ + "."):
+    if not getattr(function, "__module__", "").startswith(_CORE_PACKAGE + "."):
         return _numba_inline_function(self, caller_ir, block, i, function, arg_typs)
     global _memos
     callee_ir = _untyped_ir(self, function)
