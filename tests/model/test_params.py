@@ -3,6 +3,8 @@ import math
 
 import pytest
 
+import numpy as np
+
 from workbench.model.params import CORK_MODELS, FIELDS, ParameterError, Parameters, describe
 
 
@@ -110,3 +112,23 @@ def test_toml_round_trip_and_errors(tmp_path):
         Parameters.from_toml(broken)
     with pytest.raises(ParameterError, match="cannot read"):
         Parameters.from_toml(tmp_path / "missing.toml")
+
+
+def test_a_run_packs_its_parameters_once(monkeypatch):
+    """simulate, its static start and its linear model (the default step, the anti-alias
+    filter) share one packing of the parameters; each gets arrays of its own."""
+    from workbench.model import packing
+    from workbench.model.drives import sine
+    from workbench.model.simulate import simulate
+    calls = []
+    real = packing.pack
+
+    def counting(p):
+        calls.append(p)
+        return real(p)
+    monkeypatch.setattr(packing, "pack", counting)
+    p = Parameters().replace(gap_mm=0.9137, tip_mass=False)      # packed nowhere else
+    simulate(p, sine(20.0, 20.0, ramp_s=0.01), 0.02)
+    assert calls == [p]
+    a, b = packing.build(p), packing.build(p)
+    assert a.P is not b.P and np.array_equal(a.P, b.P) and a.P.flags.writeable

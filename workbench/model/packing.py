@@ -123,17 +123,30 @@ def shape_table(p: Parameters) -> np.ndarray:
 
 
 def build(p: Parameters, fixed: Iterable[str | int] = ()) -> Model:
-    """The kernel-side model of parameters ``p`` with ``fixed`` coordinates held."""
+    """The kernel-side model of parameters ``p`` with ``fixed`` coordinates held: fresh
+    arrays (a caller may write a method's tableau into P), copied from the parameters'
+    arrays packed once (:func:`_packed`)."""
     if not isinstance(p, Parameters):
         raise ParameterError(f"expected workbench.model.params.Parameters, got {type(p).__name__}")
     held = {coordinate_index(c) for c in fixed}
     free = np.array([i for i in range(ly.N_DOF) if i not in held], dtype=np.int64)
     if free.size == 0:
         raise ParameterError("fixed holds every coordinate; at least one must move")
+    P, tab, kc = (a.copy() for a in _packed(p))
+    return Model(P=P, tab=tab, kc=kc, free=free)
+
+
+@functools.lru_cache(maxsize=64)
+def _packed(p: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """P, the shape table and K and C of ``p``, read-only: a run packs its parameters once
+    for the run, its static start and its linear model (joint free and locked)."""
     P = pack(p)
     kc = np.zeros((2, ly.N_DOF, ly.N_DOF))
     fill_stiffness_damping(P, kc)
-    return Model(P=P, tab=shape_table(p), kc=kc, free=free)
+    arrays = (P, shape_table(p), kc)
+    for a in arrays:
+        a.flags.writeable = False
+    return arrays
 
 
 def make_work() -> Work:
