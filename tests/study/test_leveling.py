@@ -86,22 +86,22 @@ def test_a_good_estimate_needs_few_runs_and_a_point_within_limits_runs_once():
     simulate_at, calls = _fake(_ratchet(37.0))
     found = level(simulate_at, 200.0, Limits(), estimate=35.0)
     _bracketed(found, 37.0)
-    assert calls == [35.0, 35.0 * 1.25, 35.0]          # trial, up one step: bracketed; whole
+    assert calls == [35.0, 35.0 * 1.25]                # up one resolution step: bracketed
     simulate_at, calls = _fake(lambda f: {"tip": 0.001 * f})
     found = level(simulate_at, 200.0, Limits(), estimate=150.0)
     assert (found.met, found.limit, calls[-1]) == (True, "force_n", 200.0)
     simulate_at, calls = _fake(lambda f: {})
-    assert level(simulate_at, 200.0, Limits()).runs == 2 and calls == [200.0, 200.0]
+    assert level(simulate_at, 200.0, Limits()).runs == 1 and calls == [200.0]
 
 
-def test_a_limit_exceeded_only_after_the_trial_moves_the_bracket_down():
-    """A slow ratchet: above 37 N the slide reaches the end stop within the trial, between 30
-    and 37 N only later; the kept force's whole run meets the limits."""
+def test_a_limit_exceeded_late_in_the_run_moves_the_bracket_down():
+    """A slow ratchet: above 37 N the slide reaches the end stop within 4 s, between 30 and
+    37 N only later; the kept force's whole run meets the limits."""
     def responses(f):
         slow = {"late": {"slide": S_TRAVEL + 0.005}} if f > 30.0 else {}
         return {**_ratchet(37.0)(f), **slow}
     simulate_at, calls = _fake(responses)
-    found = level(simulate_at, 200.0, Limits(max_runs=30))
+    found = level(simulate_at, 200.0, Limits())
     _bracketed(found, 30.0)
     assert found.run.ok and found.run.simulated_s == 10.0 and found.limit == "slot"
 

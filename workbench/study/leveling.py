@@ -14,7 +14,7 @@ to the study's ``force_n``, at which every limit of :class:`Limits` holds over t
 The most restrictive limit decides.  The search (:func:`level`) brackets the largest force:
 
 1. run at the first estimate (the previous frequency's force in a study's chain, else the
-   study's ``force_n``) for ``trial_s`` seconds (the trial);
+   study's ``force_n``);
 2. while no run has met every limit, run again lower: for each limit exceeded, at
    ``LEVEL_MARGIN * F / ratio`` where the response follows the force (tip, accelerometers,
    force transducer), at ``F / step`` for the slide (a friction ratchet: it jumps to the
@@ -23,15 +23,13 @@ The most restrictive limit decides.  The search (:func:`level`) brackets the lar
 3. while every run has met the limits, run again at ``F * step`` (at most ``force_n``), the
    step squaring likewise;
 4. once a force that meets every limit (F_ok) and one that does not (F_over) are known, halve
-   the bracket in log force until F_over <= resolution * F_ok;
-5. run F_ok whole: if the whole run exceeds a limit (a slow ratchet reaches the end stop
-   after the trial), it becomes F_over and the search goes on from 4.
+   the bracket in log force until F_over <= resolution * F_ok.
 
 A run stops as soon as its record exceeds a limit (``simulate(stop=...)``: the record so far
-is the whole run's first part, so the verdict is the whole run's); a trial stops at
-``trial_s``.  So F_over is always a force whose whole run exceeds a limit, F_ok one whose
-whole run exceeds none; only the candidates for the kept run run whole, and the runs above the
-limits and the trials are cheap.
+is the whole run's first part, so the verdict is the whole run's), which makes the runs above
+the limits cheap.  (Short trial runs to bracket the force, the candidates then run whole, cost
+more: the slide's ratchet reaches the end stop late in the run at forces a 3 s trial passes,
+docs/performance.md.)
 
 The kept run is the one at F_ok: the force used is within ``resolution`` of the largest force
 meeting the limits, if the responses grow with the force (nearly always: a response that falls
@@ -70,7 +68,6 @@ class Limits:
     slot: bool = True                                # the slide within params.s_travel
     resolution: float = 1.25                         # F_over <= resolution * F_ok
     max_runs: int = 10                               # runs a point may take
-    trial_s: float = 3.0                             # s: the search's trial runs
 
     def ratios(self, run) -> dict[str, float]:
         """Each limit's largest response over the run divided by the limit (> 1: exceeded)."""
@@ -114,86 +111,47 @@ class Leveled:
 
 def level(simulate_at: Callable[..., object], force_max: float, limits: Limits,
           estimate: float | None = None) -> Leveled:
-    """The run (``simulate_at(force, stop=...)``, a :class:`~workbench.model.run_result.Run`) at
+    """The run (``simulate_at(force, stop=...)``, a :class:`~workbench.model.simulate.Run`) at
     the largest force up to ``force_max`` (N) meeting every limit, by the search of the
     module docstring, from ``estimate`` (N) if given."""
     force = force_max if estimate is None or not estimate > 0 else min(force_max, estimate)
     first = force
     floor = force_max * MIN_FORCE_FRACTION
-    passed: dict = {}              # force -> (run, ratios, run whole?)
-    failed: dict = {}              # force -> (run, ratios)
+    ok = over = None               # (force, run, ratios) of the largest passing, lowest failing
     down = up = limits.resolution
     runs = 0
-    whole = False
     while True:
-        run, ended = _attempt(simulate_at, force, limits, whole)
+        run = simulate_at(force, stop=limits.exceeded)
         runs += 1
         if not (run.ok or run.stopped):
-            return Leveled(run, force, runs, False, "the run failed",
-                           min(failed, default=float("nan")), first)
+            return Leveled(run, force, runs, False, "the run failed", _force(over), first)
         ratios = limits.ratios(run)
-        if ended == "limit" or max(ratios.values(), default=0.0) > 1.0:
-            failed[force] = (run, ratios)
-            passed.pop(force, None)
-        else:
-            passed[force] = (run, ratios, ended is None)
-        over = min(failed, default=None)
-        ok = max((f for f in passed if over is None or f < over), default=None)
-        if ok is not None and (ok >= force_max or (over is not None
-                                                   and over <= limits.resolution * ok)):
-            if passed[ok][2]:
-                return Leveled(passed[ok][0], ok, runs, True,
-                               "force_n" if over is None else _decider(failed[over][1]),
-                               float("nan") if over is None else over, first)
-            force, whole = ok, True          # the bracket closed on a trial: run it whole
-            continue
+        if run.ok and max(ratios.values(), default=0.0) <= 1.0:
+            if ok is None or force > ok[0]:
+                ok = (force, run, ratios)
+        elif over is None or force < over[0]:
+            over = (force, run, ratios)
+        if ok is not None and ok[0] >= force_max:
+            return Leveled(ok[1], ok[0], runs, True, "force_n", _force(over), first)
+        if ok is not None and over is not None and over[0] <= limits.resolution * ok[0]:
+            return Leveled(ok[1], ok[0], runs, True, _decider(over[2]), over[0], first)
         if runs >= limits.max_runs or (ok is None and force <= floor):
             break
-        whole = False
         if ok is not None and over is not None:
-            force = math.sqrt(ok * over)
+            force = math.sqrt(ok[0] * over[0])
         elif ok is None:
-            r = failed[over][1]
-            force = max(floor, min(over / down if name == "slot" else LEVEL_MARGIN * over / value
+            f, _, r = over
+            force = max(floor, min(f / down if name == "slot" else LEVEL_MARGIN * f / value
                                    for name, value in r.items() if value > 1.0))
             down *= down
         else:
-            force = min(force_max, ok * up)
+            force = min(force_max, ok[0] * up)
             up *= up
-    over = min(failed, default=None)
-    ok = max((f for f in passed if over is None or f < over), default=None)
-    limit = "max_runs" if over is None else _decider(failed[over][1])
-    over_n = float("nan") if over is None else over
     if ok is not None:             # the runs ran out before the bracket closed
-        if passed[ok][2]:
-            return Leveled(passed[ok][0], ok, runs, True, limit, over_n, first)
-        run, ended = _attempt(simulate_at, ok, limits, True)
-        runs += 1
-        if run.ok and limits.exceeded(run) is None:
-            return Leveled(run, ok, runs, True, limit, over_n, first)
-        if not (run.ok or run.stopped):
-            return Leveled(run, ok, runs, False, "the run failed", over_n, first)
-        over = ok                  # the trial passed, the whole run did not
-    run = simulate_at(over)        # the lowest force tried, run whole for the point's measures
-    return Leveled(run, over, runs + 1, False, limit, over, first)
-
-
-def _attempt(simulate_at, force: float, limits: Limits, whole: bool):
-    """A run at ``force`` that stops once a limit is exceeded ("limit") or, unless ``whole``,
-    at the end of the trial ("trial"); None: it ran to its end."""
-    ended = []
-
-    def stop(record):
-        reason = limits.exceeded(record)
-        if reason:
-            ended.append("limit")
-            return reason
-        if not whole and record.simulated_s >= limits.trial_s - 1e-9:
-            ended.append("trial")
-            return f"the leveling trial's {limits.trial_s:g} s"
-        return None
-    run = simulate_at(force, stop=stop)
-    return run, (ended[0] if ended else None)
+        return Leveled(ok[1], ok[0], runs, True, _decider(over[2]) if over else "max_runs",
+                       _force(over), first)
+    run = simulate_at(over[0])     # the lowest force tried, run whole for the point's measures
+    return Leveled(run, over[0], runs + 1, False, _decider(over[2]), over[0], first)
 
 
 def _force(found) -> float:
