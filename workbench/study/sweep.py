@@ -46,6 +46,10 @@ from .definition import Point, Study, load
 #: A worker whose sweep process is gone stops within this many seconds.
 WATCHDOG_S = 1.0
 
+#: The whole runs a levelled point costs: the default grid's 240 points took 1 501 CPU s
+#: levelled (4.5 runs a point, those above a limit stopped there), 2.6 times the seconds
+#: of one run a point (docs/performance.md, "A levelled grid").
+LEVELLED_RUNS = 2.6
 STATE_COLUMNS = [f"final_y{i}" for i in range(ly.N_STATE)]
 #: The integrator's account kept in a point's row (Run.summary keys).
 CONTROL_KEYS = ("steps", "steps_all", "rejected", "h_min", "h_max", "error_est_max",
@@ -192,9 +196,11 @@ def _watch(pid: int) -> None:
 
 
 def estimated_cost(study: Study, chain: list[Point]) -> float:
-    """RK4 steps of a chain: the longest chains start first, so that workers finish together."""
-    return sum(study.duration_s / (study.dt or default_dt(p.params, p.excitation_array()))
-               for p in chain)
+    """RK4 steps of a chain (a levelled point's runs counted as LEVELLED_RUNS whole runs):
+    the longest chains start first, so that workers finish together."""
+    runs = LEVELLED_RUNS if study.limits is not None else 1.0
+    return runs * sum(study.duration_s / (study.dt or default_dt(p.params, p.excitation_array()))
+                      for p in chain)
 
 
 def _unfinished(study: Study, out: Path):
