@@ -34,7 +34,7 @@ from workbench.present import figures as F
 from workbench.present import observations as O
 from workbench.present.tables import latex_text
 from workbench.study.leveling import Limits, level
-from workbench.study.metrics import accel_peak_g, validity
+from workbench.model.validity import accel_peak_g, validity
 from workbench.study.provenance import environment
 
 FORCE_N = 200.0

@@ -15,7 +15,7 @@ from workbench.present.point_checks import range_lines
 from workbench.study import definition as S
 from workbench.study import sweep as W
 from workbench.study.leveling import MIN_FORCE_FRACTION, Limits, level
-from workbench.study.metrics import G_CM_S2, N_DYN, validity
+from workbench.model.validity import G_CM_S2, N_DYN, validity
 
 S_TRAVEL = Parameters().s_travel
 

@@ -8,6 +8,7 @@ the values' rules come from the registries (:mod:`workbench.model.params`,
 from __future__ import annotations
 
 import argparse
+import difflib
 import json
 import math
 from pathlib import Path
@@ -53,10 +54,26 @@ EXIT_CODES = {EXIT_OK: "done", EXIT_RUN_FAILED: "a simulation ended with a failu
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse with one-line errors raised (not printed with the usage and exited)."""
+    """argparse with one-line errors raised (not printed with the usage and exited), naming
+    the sub-command, and for an unknown option the nearest ones the command knows."""
 
     def error(self, message):
-        raise ParameterError(f"{self.prog}: {message}")
+        command = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
+        if message.startswith("unrecognized arguments:"):
+            near = [m for word in message.split(":", 1)[1].split() if word.startswith("--")
+                    for m in difflib.get_close_matches(word.split("=")[0], self.options(), 2, 0.6)]
+            if near:
+                message += f" (did you mean {' or '.join(dict.fromkeys(near))}?)"
+        raise ParameterError(f"{command}{message}")
+
+    def options(self) -> list[str]:
+        """Every option string of this parser and its sub-commands."""
+        found = list(self._option_string_actions)
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for sub in action.choices.values():
+                    found += sub.options() if isinstance(sub, Parser) else []
+        return found
 
 
 def number(lo=None, hi=None, lo_open=False, hi_open=False, integer=False):
@@ -257,16 +274,33 @@ def drive_settings(args) -> dict:
                            duration_s=getattr(args, "duration", None))
 
 
+def _field_of(name: str):
+    """The parameter field a setting's name stands for, or None if it names none."""
+    from ..model.params import ParameterError, resolve_name
+    try:
+        return resolve_name(name)[0]
+    except ParameterError:
+        return None
+
+
 def record_settings(args, meta: dict) -> dict:
     """A record's settings (matching.py): the file's, overridden by the command line."""
     from ..model import drives
 
+    from ..model.params import resolve_name
+
     settings = dict(meta)
     given = {"gap_mm": args.gap_mm, "tip_mass": args.tip_mass, "cork": args.cork}
-    settings.update({k: v for k, v in given.items() if v is not None})
+    overrides = {k: v for k, v in given.items() if v is not None}
     if args.mu is not None:
-        settings.update(mu_s=args.mu, mu_k=args.mu)
-    settings.update({name: toml_value(text) for name, text in pairs(args.set, "--set").items()})
+        overrides.update(mu_s=args.mu, mu_k=args.mu)
+    overrides.update({name: toml_value(text) for name, text in pairs(args.set, "--set").items()})
+    for key in overrides:      # an option replaces the file's value of the same parameter
+        field = with_option(key, resolve_name, key)[0]
+        for old in [k for k in settings if k not in drives.all_keys() and k != "drive"
+                    and _field_of(k) == field]:
+            settings.pop(old)
+    settings.update(overrides)
     drive = shortcut_drive(args)
     if drive:                  # a drive given here replaces the file's (its amplitude may stay)
         for key in set(drives.all_keys()) - {"force_n", "ramp_s"} | {"drive"}:

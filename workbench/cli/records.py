@@ -65,6 +65,8 @@ def _cmd_frf(args) -> int:
                                    peak_table as peak_table_of, responses_of)
     from ..present.figures import frf_figure, save
 
+    if args.f_max is not None and args.f_min >= args.f_max:
+        raise ParameterError(f"--f-min {args.f_min:g} Hz must be below --f-max {args.f_max:g} Hz")
     path = Path(args.file)
     record = read_record(args, args.file)
     meta = record.attrs.get("meta", {})

@@ -125,12 +125,63 @@ def _cmd_run(args) -> int:
         else:
             files.write(args.out, files.record_from_run(run), meta)
     summary = run.summary()
+    if summary["out_of_range"]:
+        print(f"workbench: warning: the run left the range the model is validated for "
+              f"({range_words(summary, p)})", file=sys.stderr)
     if args.json:
         print(json_text(summary))
     else:
-        for key, value in summary.items():
-            print(f"{key:>24}: {value}")
+        print(human_summary(summary, args.out))
     return EXIT_OK if run.ok else EXIT_RUN_FAILED
+
+
+#: The keys of a run's summary the human-readable output shows, with their units.
+HUMAN_KEYS = (("status", ""), ("message", ""), ("simulated_s", "s"), ("wall_s", "s"),
+              ("method", ""), ("tol", ""), ("steps", ""), ("rejected", ""),
+              ("error_over_tol_max", "of the tolerance"), ("n_events", ""), ("n_impacts", ""),
+              ("contact_time_share", ""), ("tip_disp_peak_cm", "cm"),
+              ("slide_abs_max_cm", "cm"), ("accel_abs_max_g", "g"),
+              ("energy_balance_rel", ""), ("out_of_range", ""))
+
+
+def _plain(value) -> str:
+    """A value as a reader writes it: numbers to 4 significant digits, dicts as k: v."""
+    if isinstance(value, dict):
+        return ", ".join(f"{k}: {_plain(v)}" for k, v in value.items())
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return str(value)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return str(value)
+    return f"{int(number)}" if number.is_integer() and abs(number) < 1e15 else f"{number:.4g}"
+
+
+def human_summary(summary: dict, out=None) -> str:
+    """The run's summary in a few lines of plain numbers (``--json`` gives every key), and
+    the file written."""
+    lines = []
+    for key, unit in HUMAN_KEYS:
+        if key in summary:
+            value = summary[key]
+            if key == "contact_time_share":
+                value = {k: v for k, v in sorted(value.items(), key=lambda kv: -kv[1]) if v >= 0.01}
+            text = _plain(value) if value not in ("", None) else "-"
+            lines.append(f"{key:>20}: {text}{' ' + unit if unit and text != '-' else ''}")
+    if out:
+        lines.append(f"{'wrote':>20}: {out}")
+    return "\n".join(lines)
+
+
+def range_words(summary: dict, p) -> str:
+    """Each limit a run exceeded, with its largest value and the limit, in words."""
+    from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
+    what = {"tip": ("tip deflection", "tip_abs_max_cm", VALID_TIP_CM, "cm"),
+            "slot": ("slide", "slide_abs_max_cm", p.s_travel, "cm"),
+            "accel": ("acceleration", "accel_abs_max_g", ACCEL_RANGE_G, "g"),
+            "force": ("force1", "force1_abs_max_n", FORCE_RANGE_N, "N")}
+    return "; ".join(f"{what[k][0]} {summary[what[k][1]]:.3g} {what[k][3]} > {what[k][2]:.3g} "
+                     f"{what[k][3]}" for k in summary["out_of_range"].split(","))
 
 
 def _cmd_params(args) -> int:

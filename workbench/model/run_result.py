@@ -12,6 +12,7 @@ from ..core import layout as ly
 from . import antialias
 from .params import Parameters
 from .regimes import contact_code, contact_shares_of, in_contact
+from .validity import validity
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -205,6 +206,7 @@ class Run:
             "strain1_rms": float(np.std(self.signal("strain1"))),
             "strain2_rms": float(np.std(self.signal("strain2"))),
             "tip_disp_peak_cm": float(np.abs(tip).max()),
+            **validity(self),
         }
 
     def to_parquet(self, path) -> None:

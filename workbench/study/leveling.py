@@ -45,7 +45,7 @@ from dataclasses import asdict, dataclass
 from typing import Callable
 
 from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
-from .metrics import validity
+from ..model.validity import validity
 
 #: The margin below a limit aimed at when a proportional response sets the next force.
 LEVEL_MARGIN = 0.97

@@ -27,15 +27,9 @@ Bifurcation samples: ``tip_poincare`` lists the tip displacement (cm) once
 per forcing period, at t = k / f within the window (the drive's phase 0),
 interpolated by a cubic spline through the samples (sine runs only).
 
-The validated range (over the whole run; :func:`validity`): ``tip_abs_max_cm``
-(the tip's largest deflection from its static equilibrium), ``slide_abs_max_cm``
-(the loose body's largest |s|), ``accel_abs_max_g`` (the largest |accel1-3|, in
-g), ``force1_abs_max_n``; ``out_of_range`` names the limits a run exceeds, comma
-separated ("" within all): ``tip`` beyond VALID_TIP_CM (the paper's 8.4 cm: the
-small-slope beam shapes were compared with the rig up to there), ``slot`` beyond
-the slot's travel s_travel (the end stop, an ASSUMPTION, carries the body),
-``accel`` and ``force`` beyond the sensors' ranges (ACCEL_RANGE_G, FORCE_RANGE_N:
-a measured record would be clipped there).
+The validated range (over the whole run): the columns of
+:func:`workbench.model.validity.validity`, with ``out_of_range`` naming the
+limits a run exceeds.
 
 Steady-state indicator (the first mode, ~2 Hz with zeta < 1 %, rings for
 tens of seconds): ``steady_change`` = |RMS_last - RMS_previous| / RMS_last
@@ -50,7 +44,7 @@ import numpy as np
 
 from ..model import regimes
 from ..model.regimes import contact_shares_of, regime_time_of
-from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
+from ..model.validity import validity
 from ..model.run_result import CONTACT_STAT_KEYS
 
 CHANNELS = ("force1", "strain1", "strain2", "accel1", "accel2", "accel3", "tip")
@@ -178,38 +172,6 @@ def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
     ``events`` has columns t and to_regime (a run's events, or a reference's log).
     """
     return contact_shares_of(events.t.to_numpy(), events.to_regime.to_numpy(), t0, t1)
-
-
-G_CM_S2 = 980.665
-N_DYN = 1e5
-
-
-def tip_peak_cm(run) -> float:
-    """The tip's largest deflection (cm) from its static equilibrium over the run."""
-    return float(np.nanmax(np.abs(run.signals.tip_y.to_numpy() - run.static_tip_y)))
-
-
-def accel_peak_g(run) -> float:
-    """The largest |acceleration| of accel1-3 (g) over the run: what saturates a sensor."""
-    return float(max(np.abs(run.signals[c].to_numpy()).max()
-                     for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
-
-
-def validity(run) -> dict:
-    """The run's largest responses against the range the model is validated for (module
-    docstring)."""
-    sig = run.signals
-    tip = tip_peak_cm(run)
-    slide = float(np.abs(sig.s.to_numpy()).max())
-    force = float(np.abs(sig.force1.to_numpy()).max())
-    out = {"tip_abs_max_cm": tip, "slide_abs_max_cm": slide, "accel_abs_max_g": accel_peak_g(run),
-           "force1_abs_max_n": force / N_DYN}
-    over = [name for name, value, limit in (
-        ("tip", tip, VALID_TIP_CM), ("slot", slide, run.params.s_travel),
-        ("accel", out["accel_abs_max_g"], ACCEL_RANGE_G),
-        ("force", out["force1_abs_max_n"], FORCE_RANGE_N)) if value > limit]
-    out["out_of_range"] = ",".join(over)
-    return out
 
 
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
