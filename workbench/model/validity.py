@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import layout as ly
 from .limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
 
 #: Standard gravity (cm/s²) and a newton (dyn).
@@ -21,24 +22,31 @@ G_CM_S2 = 980.665
 N_DYN = 1e5
 
 
+def _column(run, name: str) -> np.ndarray:
+    """A run's samples of one signal (or the slide ``s``), from its arrays when it has them
+    (no DataFrame built), else from its ``signals`` table."""
+    if hasattr(run, "sensors"):
+        return run.states[:, ly.S] if name == "s" else run.signal(name)
+    return run.signals[name].to_numpy()
+
+
 def tip_peak_cm(run) -> float:
     """The tip's largest deflection (cm) from its static equilibrium over the run."""
-    return float(np.nanmax(np.abs(run.signals.tip_y.to_numpy() - run.static_tip_y)))
+    return float(np.nanmax(np.abs(_column(run, "tip_y") - run.static_tip_y)))
 
 
 def accel_peak_g(run) -> float:
     """The largest |acceleration| of accel1-3 (g) over the run: what saturates a sensor."""
-    return float(max(np.abs(run.signals[c].to_numpy()).max()
+    return float(max(np.abs(_column(run, c)).max()
                      for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
 
 
 def validity(run) -> dict:
     """The run's largest responses against the range the model is validated for (module
     docstring); ``run`` has ``signals``, ``static_tip_y`` and ``params``."""
-    sig = run.signals
     tip = tip_peak_cm(run)
-    slide = float(np.abs(sig.s.to_numpy()).max())
-    force = float(np.abs(sig.force1.to_numpy()).max())
+    slide = float(np.abs(_column(run, "s")).max())
+    force = float(np.abs(_column(run, "force1")).max())
     out = {"tip_abs_max_cm": tip, "slide_abs_max_cm": slide, "accel_abs_max_g": accel_peak_g(run),
            "force1_abs_max_n": force / N_DYN}
     over = [name for name, value, limit in (
