@@ -184,3 +184,28 @@ def test_a_failed_frf_leaves_no_folder(tmp_path, capsys):
     assert cli.main(["frf", str(path), "--out", str(tmp_path / "out")]) == 2
     assert "force1 column is zero" in capsys.readouterr().err
     assert not (tmp_path / "out").exists() and list(tmp_path.iterdir()) == [path]
+
+
+def test_the_frf_files_state_their_window_and_stop_at_the_valid_band(tmp_path, capsys):
+    """A hammer record's FRFs: the exponential window's tau and the damping correction in the
+    CSV's first line and in the UFF's own records (read back by pyuff), and no frequency past
+    the record's valid band (0.4 of its sample rate)."""
+    import pyuff
+    from workbench import cli
+    record = tmp_path / "hit.uff"
+    assert cli.main(["run", "--impulse", "joint", "--joint", "locked", "--tip-mass", "on",
+                     "--duration", "2", "--out", str(record), "--json"]) == 0
+    capsys.readouterr()
+    assert cli.main(["frf", str(record), "--out", str(tmp_path / "frf")]) == 0
+    first = (tmp_path / "frf" / "frf.csv").read_text().splitlines()[0]
+    assert first.startswith("# ") and "exponential window, tau = " in first and "subtract" in first
+    sets = pyuff.UFF(str(tmp_path / "frf" / "frf.uff")).read_sets()
+    frfs = [s for s in sets if s.get("type") == 58]
+    assert frfs and all("exponential window, tau" in s["id2"] for s in frfs)
+    rate = 1.0 / float(np.diff(cli_record_times(record))[0])
+    assert max(float(np.max(s["x"])) for s in frfs) <= 0.4 * rate * (1 + 1e-9)
+
+
+def cli_record_times(path):
+    from workbench.lab import files
+    return files.read(path).index.to_numpy()

@@ -12,7 +12,7 @@ from workbench.cli import main
 from workbench.core import layout as ly
 from workbench.core.dynamics import eval_inertia
 from workbench.model.modes import natural_frequencies
-from workbench.model.params import Parameters
+from workbench.model.params import ParameterError, Parameters
 
 BETA1_L = 1.875104    # first root of cos(bL) cosh(bL) = -1 (Blevins, Formulas for
                       # Natural Frequency and Mode Shape, Table 8-1)
@@ -65,9 +65,14 @@ def test_free_joint_has_the_rigid_modes_of_the_missing_stiffness():
 def test_cli_modes_json(capsys):
     assert main(["modes", "--tip-mass", "off", "--joint", "locked", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    expected = natural_frequencies(Parameters(tip_mass=False), "locked")
+    expected = natural_frequencies(Parameters(tip_mass=False), "locked", "static")
     assert out["frequencies_hz"] == pytest.approx(list(expected))
     assert out["frequencies_hz"] == sorted(out["frequencies_hz"])
+    assert out["about"] == "static" and "static equilibrium" in out["linearised_about"]
+    assert main(["modes", "--joint", "free", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["about"] == "undeformed"
+    assert main(["modes", "--joint", "free", "--about", "static"]) == 2
+    assert "--about static needs --joint locked" in capsys.readouterr().err
 
 
 def test_cli_reports_bad_input(capsys):
@@ -108,3 +113,29 @@ def test_cli_modes_prints_the_damping_ratios(capsys):
     out = json.loads(capsys.readouterr().out)
     assert len(out["damping_ratios"]) == len(out["frequencies_hz"])
     assert out["damping_ratios"][1] == pytest.approx(0.00437, rel=1e-2)   # mode 2, 13.9 Hz
+
+
+def test_about_the_static_equilibrium_without_gravity_is_the_undeformed_linearisation():
+    """With g = 0 the static equilibrium is the undeformed state, and the tangent stiffness by
+    central differences is the elastic one: the same frequencies to the differences' error."""
+    from workbench.model.modes import linear_matrices, natural_frequencies
+    p = Parameters(tip_mass=True).replace(g=0.0)
+    M0, K0, _ = linear_matrices(p, "locked", "undeformed")
+    Ms, Ks, _ = linear_matrices(p, "locked", "static")
+    assert np.allclose(Ms, M0, rtol=1e-9, atol=0) and np.allclose(Ks, K0, rtol=1e-5, atol=1e-3)
+    np.testing.assert_allclose(natural_frequencies(p, "locked", "static"),
+                               natural_frequencies(p, "locked", "undeformed"), rtol=1e-6)
+
+
+def test_gravity_lowers_the_bending_modes_about_the_static_equilibrium():
+    """The beams hang under gravity: about the static equilibrium modes 2-3 sit 0.1-1 % below
+    the unloaded linearisation (the shift the hammer FRFs show), the axial modes barely move."""
+    from workbench.model.modes import natural_frequencies
+    p = Parameters(tip_mass=True)
+    static = natural_frequencies(p, "locked", "static")
+    free = natural_frequencies(p, "locked", "undeformed")
+    shift = static[1:3] / free[1:3] - 1.0
+    assert np.all(shift < -1e-3) and np.all(shift > -1e-2)
+    assert abs(static[-1] / free[-1] - 1.0) < 1e-3
+    with pytest.raises(ParameterError, match="needs the joint locked"):
+        natural_frequencies(p, "free", "static")

@@ -62,7 +62,7 @@ def _cmd_frf(args) -> int:
     from ..lab.channels import reference_of
     from ..lab.formats import uff
     from ..lab.frf import (DEFAULT_SEGMENT_S, default_window, frf, magnitude_phase,
-                                   peak_table as peak_table_of, responses_of)
+                           peak_table as peak_table_of, responses_of, window_words)
     from ..present.figures import frf_figure, save
 
     if args.f_max is not None and args.f_min >= args.f_max:
@@ -91,8 +91,13 @@ def _cmd_frf(args) -> int:
     responses = responses_of(table)
     peak_table = peak_table_of({args.file: table}, responses, args.f_min,
                                args.f_max).drop(columns="source")
+    described = (f"# H1, H2 and coherence of {', '.join(responses)} against {force}, "
+                 f"0-{table.attrs['band_hz']:g} Hz (the record's valid band); window: "
+                 f"{window_words(table)}\n")
     with staged_output(out) as stage:
-        magnitude_phase(table).to_csv(stage / "frf.csv")
+        with open(stage / "frf.csv", "w") as f:
+            f.write(described)
+            magnitude_phase(table).to_csv(f)
         peak_table.to_csv(stage / "peaks.csv", index=False)
         (stage / "peaks.md").write_text(
             f"# FRF peaks (H1 against {force}, {window} window): frequency (Hz), magnitude in "
@@ -101,10 +106,12 @@ def _cmd_frf(args) -> int:
             + "\n\n" + peak_table.to_markdown(index=False, floatfmt=".4g") + "\n")
         save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against {force} "
                         f"({window} window)", args.f_max), stage / "frf")
-        uff.write_frf(stage / "frf.uff", table, responses, force, meta=meta)
+        uff.write_frf(stage / "frf.uff", table, responses, force, meta=meta,
+                      window=window_words(table))
     print(json_text({"record": args.file, "out": str(out), "force": force, "window": window,
                      "averages": table.attrs["averages"],
                      "exp_tau_s": table.attrs.get("exp_tau_s"),
+                     "window_words": window_words(table), "band_hz": table.attrs["band_hz"],
                      "resolution_hz": float(table.index[1]), "uff": str(out / "frf.uff"),
                      "figures": [str(out / f"frf.{ext}") for ext in ("png",)],
                      "peaks": peak_table.to_dict("records")}))

@@ -20,15 +20,22 @@ from .common import (EXIT_INTERNAL, EXIT_OK, EXIT_RUN_FAILED, add_drive_options,
 def _cmd_modes(args) -> int:
     from ..model.modes import damping_ratios
     p = parameters_of(args)
-    freqs, zeta = damping_ratios(p, args.joint)
+    about = args.about or ("static" if args.joint == "locked" else "undeformed")
+    if about == "static" and args.joint != "locked":
+        raise ParameterError("--about static needs --joint locked (a free joint rests on its "
+                             "contacts at the static equilibrium); use --about undeformed")
+    freqs, zeta = damping_ratios(p, args.joint, about)
+    state = ("the static equilibrium under gravity" if about == "static"
+             else "the undeformed state")
     if args.json:
         print(json_text({"frequencies_hz": [float(f) for f in freqs],
                          "damping_ratios": [None if np.isnan(z) else float(z) for z in zeta],
-                         "joint": args.joint, "tip_mass": p.tip_mass, "cork": p.cork}))
+                         "joint": args.joint, "about": about, "linearised_about": state,
+                         "tip_mass": p.tip_mass, "cork": p.cork}))
     else:
         print(f"Natural frequencies and damping ratios, joint {args.joint}, tip mass "
-              f"{'on' if p.tip_mass else 'off'}, cork {p.cork} (linearised about the undeformed "
-              "state; a rigid-body mode has no damping ratio):")
+              f"{'on' if p.tip_mass else 'off'}, cork {p.cork} (linearised about {state}; a "
+              "rigid-body mode has no damping ratio):")
         for i, (f, z) in enumerate(zip(freqs, zeta), 1):
             print(f"  mode {i}: {f:12.4f} Hz  zeta " + ("   -" if np.isnan(z) else f"{z:.5f}"))
     return EXIT_OK
@@ -114,10 +121,12 @@ def _cmd_run(args) -> int:
         check_output_file("--out", args.out, files.SUFFIXES)
         meta = settings_of(drive, p)
         files.check_settings(args.out, meta)
+    from ..model.packing import JOINT
     run = simulate(p, ex, args.duration, dt=args.dt, output_hz=args.output_hz,
                    method=args.method, tol=args.tol, initial=args.initial,
                    progress=not args.json and sys.stderr.isatty(),
-                   check_accuracy=args.check_accuracy, **start)
+                   check_accuracy=args.check_accuracy,
+                   fixed=JOINT if args.joint == "locked" else (), **start)
     if args.out:
         if files.format_of(args.out) == "parquet":       # the whole run: every signal, events
             run.signals.attrs["meta"] = meta
@@ -209,6 +218,10 @@ def add_parsers(sub) -> None:
     add_model_options(modes)
     modes.add_argument("--joint", choices=("locked", "free"), default="locked",
                        help="locked: s = v = psi = 0; free: held only by the cork")
+    modes.add_argument("--about", choices=("static", "undeformed"), default=None,
+                       help="linearise about the static equilibrium under gravity (the default "
+                       "with the joint locked) or the undeformed state (the default, and the "
+                       "only one, with the joint free)")
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.set_defaults(func=_cmd_modes)
 
@@ -234,6 +247,9 @@ def add_parsers(sub) -> None:
                      help="also run a companion at a tenth of --tol and half the step (or a quarter "
                      "of a fixed --dt) and "
                      "report the error measured against it (error_measured)")
+    run.add_argument("--joint", choices=("free", "locked"), default="free",
+                     help="free (default): the loose body moves in its gap; locked: s = v = psi "
+                     "= 0, as workbench modes --joint locked (a hammer test of the locked joint)")
     run.add_argument("--initial", choices=("static", "paper"), default="static",
                      help="static equilibrium (default) or the paper's undeformed free start")
     run.add_argument("--out", metavar="FILE", help="write the signals, in the format of the suffix: "

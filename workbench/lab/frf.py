@@ -48,6 +48,7 @@ import numpy as np
 import pandas as pd
 from scipy import signal
 
+from ..model.antialias import PASSBAND
 from ..model.params import ParameterError
 from .channels import kind
 
@@ -83,7 +84,7 @@ def default_window(drive: str | None) -> str:
 
 def frf(record: pd.DataFrame, responses=None, force: str = "force1",
         segment_s: float | None = DEFAULT_SEGMENT_S, skip_s: float = 0.0,
-        window: str = "hann") -> pd.DataFrame:
+        window: str = "hann", band_hz: float | None = None) -> pd.DataFrame:
     """H1, H2 and the coherence of each response channel against the force.
 
     ``record`` is indexed by time (s) with the force column (N or dyn: the
@@ -95,7 +96,9 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
     response r, the columns ``r_H1``, ``r_H2`` (complex) and
     ``r_coherence``; ``attrs`` holds the window and, for ``impact``, the
     exponential window's ``exp_tau_s`` (s) that :func:`peaks` corrects the
-    damping for.  Raises ParameterError on a record it cannot use.
+    damping for.  The frequencies stop at ``band_hz``, by default the record's valid band,
+    PASSBAND of its sample rate (an anti-aliased record's, as the workbench writes them and
+    a DAQ records them).  Raises ParameterError on a record it cannot use.
     """
     if window not in WINDOWS:
         raise ParameterError(f"window = {window!r}; allowed: {', '.join(WINDOWS)}")
@@ -123,6 +126,7 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
         if not np.all(np.isfinite(record[c].to_numpy(dtype=float)[keep])):
             raise ParameterError(f"the {c} column has values that are not finite")
     fs = 1.0 / dt[0]
+    band_hz = PASSBAND * fs if band_hz is None else band_hz
     if segment_s is None or window == "impact":
         segment_s = len(t) / fs
     if not 0.0 < segment_s <= len(t) / fs * (1 + 1e-9):
@@ -133,7 +137,8 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
     if not np.any(f_in):
         raise ParameterError(f"the {force} column is zero: no force to refer the response to")
     if window == "impact":
-        return _impact_frf(t, f_in, {r: record[r].to_numpy(dtype=float)[keep] for r in responses})
+        table = _impact_frf(t, f_in, {r: record[r].to_numpy(dtype=float)[keep] for r in responses})
+        return _within(table, band_hz)
     taper = "hann" if window == "hann" else "boxcar"
     kw = dict(fs=fs, window=taper, nperseg=nperseg, noverlap=nperseg // 2 if window == "hann" else 0,
               detrend="constant")
@@ -151,8 +156,30 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
         out[f"{r}_H2"] = h2
         out[f"{r}_coherence"] = np.clip(np.nan_to_num(coh.real), 0.0, 1.0)
     table = pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
-    table.attrs.update(window=window, averages=1 + max(0, (len(t) - nperseg) // (nperseg - kw["noverlap"])))
-    return table
+    table.attrs.update(window=window, averages=1 + max(0, (len(t) - nperseg) // (nperseg - kw["noverlap"])),
+                       segment_s=nperseg / fs)
+    return _within(table, band_hz)
+
+
+def _within(table: pd.DataFrame, band_hz: float) -> pd.DataFrame:
+    """The rows up to band_hz (Hz), the band kept in ``attrs["band_hz"]``."""
+    out = table[table.index <= band_hz * (1 + 1e-12)]
+    out.attrs.update(table.attrs, band_hz=float(band_hz))
+    return out
+
+
+def window_words(table: pd.DataFrame) -> str:
+    """The window an FRF table was estimated with and the damping correction it needs, in
+    one line (for the files' headers)."""
+    a = table.attrs
+    if a.get("window") == "impact":
+        return (f"force window on the hit and exponential window, tau = {a['exp_tau_s']:.6g} s "
+                f"(a fitted damping ratio reads 1/(2 pi f tau) too high: subtract it; peaks "
+                f"are corrected)")
+    shape = "Hann" if a.get("window") == "hann" else "rectangular (none)"
+    return (f"{shape} window, {a.get('averages', 1)} average(s) of {a.get('segment_s', 0):.6g} s "
+            f"segments{', half overlap' if a.get('window') == 'hann' else ''}; no damping "
+            "correction")
 
 
 def impact_windows(t: np.ndarray, force: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, int]:
@@ -185,7 +212,7 @@ def _impact_frf(t, force, responses: dict) -> pd.DataFrame:
         out[f"{r}_H2"] = h
         out[f"{r}_coherence"] = np.full(len(freq), np.nan)
     table = pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
-    table.attrs.update(window="impact", averages=1, exp_tau_s=tau)
+    table.attrs.update(window="impact", averages=1, exp_tau_s=tau, segment_s=n * (t[1] - t[0]))
     return table
 
 

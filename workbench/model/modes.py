@@ -1,11 +1,21 @@
-"""Natural frequencies of the model linearised about the undeformed state.
+"""Natural frequencies of the model linearised about the undeformed state or, joint locked,
+about the static equilibrium under gravity.
 
-At q = 0, q' = 0 the linearised free vibration is M(0) x'' + K_lin x = 0 with
-M(0) the kernel's mass matrix and K_lin the elastic stiffness plus the
-cork's tangent stiffness at s = 0 (k for the linear and static models, 0 for
-the quadratic and cubic ones) and the optional loose-body springs.  Gravity's
-geometric stiffness is not included: the undeformed state is not the static
-equilibrium, so its linearisation is the customary unloaded one.
+``about="undeformed"``: at q = 0, q' = 0 the linearised free vibration is
+M(0) x'' + K_lin x = 0 with M(0) the kernel's mass matrix and K_lin the
+elastic stiffness plus the cork's tangent stiffness at s = 0 (k for the
+linear and static models, 0 for the quadratic and cubic ones) and the
+optional loose-body springs; gravity's geometric stiffness is not included
+(the customary unloaded linearisation).  The step policy takes these
+(:func:`linear_eigenvalues`).
+
+``about="static"`` (joint locked): at the static equilibrium q_s
+(:func:`workbench.model.statics.static_equilibrium`) the mass matrix is
+M(q_s) and the stiffness the tangent -dQ/dq of the generalised force at rest
+(elastic, gravity, cork; the equilibrium's own kernel), by central
+differences: what a hammer test of the rig at rest measures.  A free joint
+rests on its contacts there, whose linearisation is a constrained one, not
+done here.
 
 Joint ``locked`` holds s = v = psi = 0; joint ``free`` leaves them to the
 cork alone, so v and psi (and s with a quadratic or cubic cork) have no
@@ -24,10 +34,22 @@ from ..core.dynamics import eval_inertia
 from .params import ParameterError, Parameters
 
 
-def linear_matrices(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """M(0) and K_lin restricted to the moving coordinates, and their names."""
+#: Where the model may be linearised.
+ABOUT = ("undeformed", "static")
+#: The central-difference step of the tangent stiffness, relative to a coordinate's size
+#: (at least 1 cm or 1 rad).
+FD_REL = 1e-6
+
+
+def linear_matrices(p: Parameters, joint: str = "locked",
+                    about: str = "undeformed") -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """M and K restricted to the moving coordinates (module docstring), and their names."""
     if joint not in ("locked", "free"):
         raise ParameterError(f"joint must be 'locked' or 'free', got {joint!r}")
+    if about not in ABOUT:
+        raise ParameterError(f"about must be one of {ABOUT}, got {about!r}")
+    if about == "static":
+        return _about_static(p, joint)
     model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
     work = mdl.make_work()
     zero = np.zeros(ly.N_DOF)
@@ -40,6 +62,37 @@ def linear_matrices(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, n
     return M[np.ix_(f, f)], K[np.ix_(f, f)], [ly.COORD_NAMES[i] for i in f]
 
 
+def _about_static(p: Parameters, joint: str):
+    """M(q_s) and the tangent stiffness at the static equilibrium, joint locked."""
+    from ..core.equilibrium import static_state
+    from .drives import none
+    from .statics import static_equilibrium
+    if joint != "locked":
+        raise ParameterError("linearising about the static equilibrium needs the joint locked "
+                             "(a free joint rests on its contacts): use about='undeformed'")
+    q_s = static_equilibrium(p, 0.0, mdl.JOINT).q
+    model, work, ex = mdl.build(p, fixed=mdl.JOINT), mdl.make_work(), none()
+    f = model.free
+    case = (q_s.copy(), f, np.zeros(0, dtype=np.int64), False, 0.0)
+    q, Q, res, energy = (np.zeros(ly.N_DOF), np.zeros(ly.N_DOF), np.zeros(len(f)),
+                         np.zeros(4))
+
+    def force(z):
+        static_state(z, case, model, ex, work, q, Q, res, energy)
+        return Q[f].copy()
+    z0 = q_s[f].copy()
+    K = np.empty((len(f), len(f)))
+    for j in range(len(f)):
+        h = FD_REL * max(1.0, abs(z0[j]))
+        up, down = z0.copy(), z0.copy()
+        up[j] += h
+        down[j] -= h
+        K[:, j] = -(force(up) - force(down)) / (2.0 * h)
+    eval_inertia(q_s, np.zeros(ly.N_DOF), model, work)
+    M = work.mat[ly.MAT_M][np.ix_(f, f)].copy()
+    return M, 0.5 * (K + K.T), [ly.COORD_NAMES[i] for i in f]
+
+
 #: Eigenvalues below this fraction of the largest are rigid-body modes (0 Hz).
 RIGID_REL = 1e-12
 
@@ -49,17 +102,19 @@ def _to_hz(lam: np.ndarray) -> np.ndarray:
     return np.sqrt(lam) / (2.0 * np.pi)
 
 
-def natural_frequencies(p: Parameters, joint: str = "locked") -> np.ndarray:
+def natural_frequencies(p: Parameters, joint: str = "locked",
+                        about: str = "undeformed") -> np.ndarray:
     """Natural frequencies (Hz), ascending; rigid-body modes give exactly 0."""
     import scipy.linalg         # here, not at import: a run needs only linear_eigenvalues
-    M, K, _ = linear_matrices(p, joint)
+    M, K, _ = linear_matrices(p, joint, about)
     return _to_hz(scipy.linalg.eigh(K, M, eigvals_only=True))
 
 
-def mode_shapes(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray, list[str]]:
+def mode_shapes(p: Parameters, joint: str = "locked",
+                about: str = "undeformed") -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Frequencies (Hz), mass-normalised mode shapes (columns) and coordinate names."""
     import scipy.linalg
-    M, K, names = linear_matrices(p, joint)
+    M, K, names = linear_matrices(p, joint, about)
     lam, vec = scipy.linalg.eigh(K, M)
     return _to_hz(lam), vec, names
 
@@ -92,8 +147,8 @@ def linear_damping(p: Parameters, joint: str = "locked") -> np.ndarray:
     return C
 
 
-def _state_matrix(p: Parameters, joint: str) -> np.ndarray:
-    M, K, _ = linear_matrices(p, joint)
+def _state_matrix(p: Parameters, joint: str, about: str = "undeformed") -> np.ndarray:
+    M, K, _ = linear_matrices(p, joint, about)
     C = linear_damping(p, joint)
     _check_conditioned(M, K, joint)
     n = len(M)
@@ -105,7 +160,8 @@ def _state_matrix(p: Parameters, joint: str) -> np.ndarray:
 MODE_MATCH_REL = 0.05
 
 
-def damping_ratios(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np.ndarray]:
+def damping_ratios(p: Parameters, joint: str = "locked",
+                   about: str = "undeformed") -> tuple[np.ndarray, np.ndarray]:
     """Natural frequencies (Hz, as :func:`natural_frequencies`) and each mode's damping ratio.
 
     The ratio of mode i is -Re(lambda) / |lambda| of the damped system's eigenvalue
@@ -116,8 +172,8 @@ def damping_ratios(p: Parameters, joint: str = "locked") -> tuple[np.ndarray, np
     phi_i^T C phi_i / (2 omega_i) of its mass-normalised shape.  Rigid-body modes (0 Hz)
     have NaN.
     """
-    f, shapes, _ = mode_shapes(p, joint)
-    lam = np.linalg.eigvals(_state_matrix(p, joint))
+    f, shapes, _ = mode_shapes(p, joint, about)
+    lam = np.linalg.eigvals(_state_matrix(p, joint, about))
     lam = lam[lam.imag > 0.0]
     C = linear_damping(p, joint)
     zeta = np.full(len(f), np.nan)

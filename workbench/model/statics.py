@@ -157,7 +157,8 @@ def _solve_equilibrium(p, tip_load_n, fixed, s0, q_guess):
     guess = np.zeros(ly.N_DOF) if q_guess is None else np.array(q_guess, dtype=float)
     guess[ly.S] = s0
     sets = list(range(1, ly.N_SETS))
-    if p.k_v > 0 and p.k_psi > 0:
+    held_joint = ly.V not in st.free and ly.PSI not in st.free
+    if (p.k_v > 0 and p.k_psi > 0) or held_joint:   # the body can rest without contact
         sets.insert(0, 0)
     for hold_s in (True, False):
         found = [e for e in (_solve_set(st, guess, k, hold_s) for k in sets) if e is not None]

@@ -215,9 +215,11 @@ def write(path, record, meta: dict | None = None) -> Path:
 
 
 def write_frf(path, table, responses, force: str = "force1", estimate: str = "H1",
-              meta: dict | None = None) -> Path:
+              meta: dict | None = None, window: str = "") -> Path:
     """Write FRFs (:func:`workbench.lab.frf.frf`'s table, CGS ratios) as UFF
-    dataset 58, function type 4, in SI: each response over the force."""
+    dataset 58, function type 4, in SI: each response over the force.  ``window`` (the
+    window and its damping correction, in words) goes into each record's ID line 2 (80
+    characters) and, whole, into the header's description (dataset 151)."""
     path = Path(path)
     f = table.index.to_numpy(dtype=float)
     step = float(f[1] - f[0])
@@ -225,13 +227,16 @@ def write_frf(path, table, responses, force: str = "force1", estimate: str = "H1
     now = f"{_dt.datetime.now():%d-%b-%y %H:%M:%S}"
     drive = (meta or {}).get("drive")
     sets = _header_sets(path, _parameters(meta), drive)
+    if window:
+        sets[0]["description"] = f"window: {window}"[:80]
     f_unit = DEFAULT_UNITS["force"]
     for i, r in enumerate(responses):
         k = kind(r)
         to_si = 1.0 / _si_factor(k) * _si_factor("force")       # (CGS response / dyn) -> SI / N
         length_exp, force_exp = EXPONENTS[k]
         sets.append(_record_58(
-            id1=f"{TABLE2_NAMES[r]}/{TABLE2_NAMES[force]} {estimate}", id2="workbench FRF",
+            id1=f"{TABLE2_NAMES[r]}/{TABLE2_NAMES[force]} {estimate}",
+            id2=f"workbench FRF; {window}"[:80] if window else "workbench FRF",
             id3=now, id4=settings[2 * i], id5=settings[2 * i + 1], func_type=4,
             rsp_ent_name=TABLE2_NAMES[r], rsp_node=NODES[r], rsp_dir=DIRECTIONS[k],
             ref_ent_name=TABLE2_NAMES[force], ref_node=NODES[force], ref_dir=direction(force, drive),
