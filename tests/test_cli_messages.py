@@ -56,3 +56,15 @@ def test_frf_refuses_a_band_whose_lowest_frequency_is_above_its_highest(tmp_path
     assert cli.main(["frf", str(record), "--f-min", "60", "--f-max", "5",
                      "--out", str(tmp_path / "f")]) == 2
     assert "--f-min 60 Hz must be below --f-max 5 Hz" in capsys.readouterr().err
+
+
+def test_compare_leaves_out_a_channel_the_simulation_lacks_and_says_so(tmp_path, capsys):
+    """A hammer record compared with a sine run: the hammer channel is left out, by name."""
+    record = tmp_path / "hit.tdms"
+    assert cli.main(["run", "--impulse", "joint", "--duration", "0.5", "--out", str(record),
+                     "--json"]) == 0
+    capsys.readouterr()
+    assert cli.main(["compare", str(record), "--freq-hz", "20", "--out",
+                     str(tmp_path / "cmp")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["notes"] == ["compared on the channels both have; the simulation has no hammer"]

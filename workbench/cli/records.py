@@ -54,7 +54,8 @@ def _cmd_compare(args) -> int:
     print(json_text({"record": args.file, "simulation_status": run.status, "out": str(out),
                       "figures": [str(p) for p in result.figures if p.suffix == ".png"],
                       "rms_error_rel": dict(zip(result.signals.channel,
-                                                result.signals.rms_error_rel.round(4)))}))
+                                                result.signals.rms_error_rel.round(4))),
+                      "notes": result.notes}))
     return EXIT_OK if run.ok else EXIT_RUN_FAILED
 
 

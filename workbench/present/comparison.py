@@ -35,7 +35,11 @@ def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
     result = Comparison(signal_differences(rec_w, sim_w), peak_shifts(rec_w, sim_w),
                         contact_differences(rec_codes, sim_codes), [])
     sources = {"record": rec_w, "simulation": sim_w}
-    channels = [c for c in SIGNALS if c in record.columns]
+    channels = [c for c in SIGNALS if c in record.columns and c in sim.columns]
+    left_out = [c for c in SIGNALS if c in record.columns and c not in sim.columns]
+    if left_out:
+        result.notes.append(f"compared on the channels both have; the simulation has no "
+                            f"{', '.join(left_out)}")
     result.figures += F.save(F.overlay_time_history(sources, channels, title, seconds),
                              out / "time_history")
     spectra = [c for c in channels if kind(c) != "force"] or channels
