@@ -68,3 +68,11 @@ def test_compare_leaves_out_a_channel_the_simulation_lacks_and_says_so(tmp_path,
                      str(tmp_path / "cmp")]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["notes"] == ["compared on the channels both have; the simulation has no hammer"]
+
+
+def test_an_option_and_its_parameter_state_one_allowed_range(capsys):
+    assert cli.main(["run", "--gap-mm", "9"]) == 2
+    option = capsys.readouterr().err
+    assert cli.main(["run", "--set", "gap_mm=9"]) == 2
+    parameter = capsys.readouterr().err
+    assert "allowed range (0, 5]" in option and "allowed range (0, 5] mm" in parameter

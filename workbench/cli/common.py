@@ -324,9 +324,22 @@ def read_record(args, path):
     return files.read(path, strain_scale(args), files.format_of(path, args.format))
 
 
+def parameter_number(name: str):
+    """An argparse type for a model parameter given as ``name`` (its unit suffix, if any):
+    the parameter's own allowed range, so that every message states one range."""
+    from ..model.params import FIELDS, resolve_name
+    field, to_cgs = resolve_name(name)
+    meta = FIELDS[field].metadata
+    lo = None if meta["lo"] is None else meta["lo"] / to_cgs
+    hi = None if meta["hi"] is None else meta["hi"] / to_cgs
+    return number(lo, hi, lo_open=meta["lo_open"], hi_open=meta["hi_open"])
+
+
 def add_joint_options(parser) -> None:
-    parser.add_argument("--gap-mm", type=number(0, lo_open=True), help="total transverse clearance (mm)")
-    parser.add_argument("--mu", type=number(0, 5), help="friction coefficient (sets mu_s = mu_k)")
+    parser.add_argument("--gap-mm", type=parameter_number("gap_mm"),
+                        help="total transverse clearance (mm)")
+    parser.add_argument("--mu", type=parameter_number("mu_s"),
+                        help="friction coefficient (sets mu_s = mu_k)")
 
 
 def add_record_options(parser) -> None:
