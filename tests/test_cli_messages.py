@@ -76,3 +76,4 @@ def test_an_option_and_its_parameter_state_one_allowed_range(capsys):
     assert cli.main(["run", "--set", "gap_mm=9"]) == 2
     parameter = capsys.readouterr().err
     assert "allowed range (0, 5]" in option and "allowed range (0, 5] mm" in parameter
+

@@ -46,6 +46,9 @@ from .definition import Point, Study, load
 #: A worker whose sweep process is gone stops within this many seconds.
 WATCHDOG_S = 1.0
 
+#: Seconds a sweep spends before its first point: the workers' start, their imports and
+#: the kernels loaded from the cache (2.9 s of the docs' 2-point example's 3.3 s, 2 workers).
+WORKER_START_S = 3.0
 #: The whole runs a levelled point costs: the default grid's 240 points took 1 501 CPU s
 #: levelled (4.5 runs a point, those above a limit stopped there), 2.6 times the seconds
 #: of one run a point (docs/performance.md, "A levelled grid").
@@ -216,7 +219,8 @@ def plan(study: Study, results: str | Path = "results", fresh: bool = False,
     """What a sweep would do: points, how many are finished, the expected steps and wall time.
 
     The wall time uses the study's own past seconds per step (runs.json) if
-    it has run before, else its method's ``seconds_per_step``; divided by the workers.
+    it has run before, else its method's ``seconds_per_step`` and WORKER_START_S; divided
+    by the workers.
     """
     out = Path(results) / study.name
     if fresh:
@@ -231,9 +235,12 @@ def plan(study: Study, results: str | Path = "results", fresh: bool = False,
         per_step = sum(r["wall_s"] * r.get("jobs", 1) for r in past) / sum(r["steps"] for r in past)
         basis = "this study's earlier runs"
     n_todo = sum(len(c) for c, _ in todo)
+    wall = steps * per_step / max(1, min(jobs, len(todo) or 1))
+    if todo and basis == "assumed":
+        wall += WORKER_START_S
     return {"study": study.name, "points": study.n_points, "to_run": n_todo,
             "finished": study.n_points - n_todo, "chains": len(keys), "steps": int(steps),
-            "expected_wall_s": float(f"{steps * per_step / max(1, min(jobs, len(todo) or 1)):.3g}"),
+            "expected_wall_s": float(f"{wall:.3g}"),
             "seconds_per_step": per_step, "seconds_per_step_from": basis,
             "results": str(out)}
 
