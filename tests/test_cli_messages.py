@@ -77,3 +77,19 @@ def test_an_option_and_its_parameter_state_one_allowed_range(capsys):
     parameter = capsys.readouterr().err
     assert "allowed range (0, 5]" in option and "allowed range (0, 5] mm" in parameter
 
+
+
+def test_run_help_states_each_default(capsys):
+    """Every option of ``workbench run`` with a default says it in --help."""
+    import contextlib
+    import io
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer):
+        assert cli.main(["run", "--help"]) == 0
+    text = " ".join(buffer.getvalue().split())
+    for option in ("--tip-mass", "--cork", "--gap-mm", "--mu", "--duration", "--dt",
+                   "--method", "--tol", "--output-hz", "--joint", "--initial", "--force-n",
+                   "--ramp-s", "--pulse-s", "--hit-s"):
+        after = text.split(f"{option} ", 2)[-1][:260]
+        assert "default" in after, option
+    assert "see docs/usage.md" not in text

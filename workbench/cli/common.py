@@ -154,8 +154,11 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--params", metavar="FILE.toml", help="parameters from a TOML file")
     parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
                         help="set one parameter (repeatable), e.g. --set gap_mm=0.762")
-    parser.add_argument("--tip-mass", type=on_off, metavar="on|off", help="attach the tip mass")
-    parser.add_argument("--cork", choices=sorted(CORK_MODELS), help="cork model (docs/model.md §6)")
+    default = Parameters()
+    parser.add_argument("--tip-mass", type=on_off, metavar="on|off",
+                        help=f"attach the tip mass (default {'on' if default.tip_mass else 'off'})")
+    parser.add_argument("--cork", choices=sorted(CORK_MODELS),
+                        help=f"cork model (docs/model.md §6; default {default.cork})")
 
 
 def parameters_of(args) -> Parameters:
@@ -248,12 +251,14 @@ def add_drive_options(parser, ramp_help="soft-start ramp of sine/chirp (s)") -> 
     drive.add_argument("--impulse", choices=("joint", "tip"),
                        help="half-sine hammer: vertical at the joint body, or axial at the tip")
     drive.add_argument("--force-n", type=number(-MAX_FORCE_N, MAX_FORCE_N),
-                       help="shaker amplitude or hammer peak (N); default: see docs/usage.md")
+                       help=f"shaker amplitude or hammer peak (N; default "
+                            f"{drives.DEFAULT_FORCE_N:g} for a shaker, "
+                            f"{drives.DEFAULT_HAMMER_N:g} for a hammer)")
     drive.add_argument("--ramp-s", type=number(0), help=ramp_help)
     drive.add_argument("--pulse-s", type=number(0, lo_open=True), default=drives.DEFAULTS["width_s"],
-                       help="hammer pulse duration (s)")
+                       help=f"hammer pulse duration (s; default {drives.DEFAULTS['width_s']:g})")
     drive.add_argument("--hit-s", type=number(0), default=drives.DEFAULTS["t_hit_s"],
-                       help="hammer pulse start (s)")
+                       help=f"hammer pulse start (s; default {drives.DEFAULTS['t_hit_s']:g})")
     drive.add_argument("--drive", metavar="KIND",
                        help="any registered drive (workbench/model/drives.py), set by --drive-set")
     drive.add_argument("--drive-set", metavar="KEY=VALUE", action="append", default=[],
@@ -336,10 +341,11 @@ def parameter_number(name: str):
 
 
 def add_joint_options(parser) -> None:
+    default = Parameters()
     parser.add_argument("--gap-mm", type=parameter_number("gap_mm"),
-                        help="total transverse clearance (mm)")
+                        help=f"total transverse clearance (mm; default {default.gap * 10:g})")
     parser.add_argument("--mu", type=parameter_number("mu_s"),
-                        help="friction coefficient (sets mu_s = mu_k)")
+                        help=f"friction coefficient (sets mu_s = mu_k; default {default.mu_s:g})")
 
 
 def add_record_options(parser) -> None:

@@ -230,7 +230,8 @@ def add_parsers(sub) -> None:
     add_joint_options(run)
     add_drive_options(run, ramp_help=f"soft-start ramp of sine/chirp (s); default "
                                       f"{drives.DEFAULTS['ramp_s']:g} s, or half the run if shorter")
-    run.add_argument("--duration", type=number(0, MAX_DURATION_S, lo_open=True), default=1.0, help="simulated time (s)")
+    run.add_argument("--duration", type=number(0, MAX_DURATION_S, lo_open=True), default=1.0,
+                     help="simulated time (s; default 1)")
     run.add_argument("--dt", type=number(MIN_DT, MAX_DT),
                      help="fixed RK4 step (s; implies --method rk4 unless --tol is given); default "
                      "from the model's fastest mode")
