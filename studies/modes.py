@@ -1,6 +1,7 @@
 """Modal table of the model: natural frequencies and damping ratios for tip
-mass on/off, joint locked/free and every cork model, linearised about the
-undeformed state.
+mass on/off, joint locked/free and every cork model, linearised as
+``workbench modes`` does: the locked joint about the static equilibrium under
+gravity, the free joint about the undeformed state (``workbench.model.modes``).
 
 Writes ``modes.csv``, ``modes.md`` and ``provenance.json`` into ``--out``;
 part of ``make study``.
@@ -27,9 +28,10 @@ def table() -> pd.DataFrame:
         for joint in ("locked", "free"):
             for cork in (CORK_MODELS if joint == "free" else ["cubic"]):
                 p = Parameters(tip_mass=tip, cork=cork)
-                f, zeta = damping_ratios(p, joint)
+                about = "static" if joint == "locked" else "undeformed"
+                f, zeta = damping_ratios(p, joint, about)
                 rigid = int((f == 0.0).sum())
-                row = {"tip_mass": "on" if tip else "off", "joint": joint,
+                row = {"tip_mass": "on" if tip else "off", "joint": joint, "about": about,
                        "cork": cork if joint == "free" else "-", "rigid_modes": rigid}
                 for i, (fi, zi) in enumerate(zip(f[f > 0.0][:N_MODES], zeta[f > 0.0][:N_MODES])):
                     row[f"f{i + 1}_hz"] = fi
@@ -59,9 +61,11 @@ def main() -> None:
     df.to_csv(args.out / "modes.csv", index=False, float_format="%.6g")
     note = ("Natural frequencies (Hz) and damping ratios (zeta: -Re/|lambda| of the damped "
             "linear system's eigenvalue, the beams' structural damping and the cork's damper) "
-            "of the 9-DOF model linearised about the undeformed "
-            "state (gravity's geometric stiffness omitted). Joint 'locked' holds s = v = psi = 0; "
-            "'free' leaves them to the cork, whose tangent stiffness at s = 0 is zero for the "
+            "of the 9-DOF model, linearised ('about') with the joint locked (s = v = psi = 0) "
+            "about the static equilibrium under gravity (what a hammer test of the rig at rest "
+            "measures), with the joint free about the undeformed state (gravity's geometric "
+            "stiffness omitted; the free joint rests on its contacts at the static "
+            "equilibrium). 'free' leaves s, v, psi to the cork, whose tangent stiffness at s = 0 is zero for the "
             "quadratic and cubic models: those coordinates are rigid-body modes (counted in "
             "rigid_modes, 0 Hz) and the elastic frequencies follow.\n\n")
     (args.out / "modes.md").write_text("# Modal table\n\n" + note
