@@ -133,10 +133,11 @@ def _cmd_run(args) -> int:
             run.to_parquet(args.out)
         else:
             files.write(args.out, files.record_from_run(run), meta)
+    from ..model.validity import exceeded_words
     summary = run.summary()
     if summary["out_of_range"]:
         print(f"workbench: warning: the run left the range the model is validated for "
-              f"({range_words(summary, p)})", file=sys.stderr)
+              f"({exceeded_words(summary, p)})", file=sys.stderr)
     if args.json:
         print(json_text(summary))
     else:
@@ -180,17 +181,6 @@ def human_summary(summary: dict, out=None) -> str:
     if out:
         lines.append(f"{'wrote':>20}: {out}")
     return "\n".join(lines)
-
-
-def range_words(summary: dict, p) -> str:
-    """Each limit a run exceeded, with its largest value and the limit, in words."""
-    from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
-    what = {"tip": ("tip deflection", "tip_abs_max_cm", VALID_TIP_CM, "cm"),
-            "slot": ("slide", "slide_abs_max_cm", p.s_travel, "cm"),
-            "accel": ("acceleration", "accel_abs_max_g", ACCEL_RANGE_G, "g"),
-            "force": ("force1", "force1_abs_max_n", FORCE_RANGE_N, "N")}
-    return "; ".join(f"{what[k][0]} {summary[what[k][1]]:.3g} {what[k][3]} > {what[k][2]:.3g} "
-                     f"{what[k][3]}" for k in summary["out_of_range"].split(","))
 
 
 def _cmd_params(args) -> int:

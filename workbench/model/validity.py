@@ -41,17 +41,35 @@ def accel_peak_g(run) -> float:
                      for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
 
 
+#: Each limit of the validated range: its response's column, unit and name in words.
+RESPONSES = {"tip": ("tip_abs_max_cm", "cm", "tip deflection"),
+             "slot": ("slide_abs_max_cm", "cm", "slide"),
+             "accel": ("accel_abs_max_g", "g", "acceleration"),
+             "force": ("force1_abs_max_n", "N", "force1")}
+
+
+def validated_limits(params) -> dict[str, float]:
+    """The validated range's limits (module docstring), in the units of RESPONSES."""
+    return {"tip": VALID_TIP_CM, "slot": params.s_travel, "accel": ACCEL_RANGE_G,
+            "force": FORCE_RANGE_N}
+
+
 def validity(run) -> dict:
     """The run's largest responses against the range the model is validated for (module
     docstring); ``run`` has ``signals``, ``static_tip_y`` and ``params``."""
-    tip = tip_peak_cm(run)
-    slide = float(np.abs(_column(run, "s")).max())
-    force = float(np.abs(_column(run, "force1")).max())
-    out = {"tip_abs_max_cm": tip, "slide_abs_max_cm": slide, "accel_abs_max_g": accel_peak_g(run),
-           "force1_abs_max_n": force / N_DYN}
-    over = [name for name, value, limit in (
-        ("tip", tip, VALID_TIP_CM), ("slot", slide, run.params.s_travel),
-        ("accel", out["accel_abs_max_g"], ACCEL_RANGE_G),
-        ("force", out["force1_abs_max_n"], FORCE_RANGE_N)) if value > limit]
-    out["out_of_range"] = ",".join(over)
+    out = {"tip_abs_max_cm": tip_peak_cm(run),
+           "slide_abs_max_cm": float(np.abs(_column(run, "s")).max()),
+           "accel_abs_max_g": accel_peak_g(run),
+           "force1_abs_max_n": float(np.abs(_column(run, "force1")).max()) / N_DYN}
+    limits = validated_limits(run.params)
+    out["out_of_range"] = ",".join(name for name, (column, _, _) in RESPONSES.items()
+                                   if out[column] > limits[name])
     return out
+
+
+def exceeded_words(responses: dict, params) -> str:
+    """Each limit ``responses`` (validity's columns) exceed, with value and limit, in words."""
+    limits = validated_limits(params)
+    return "; ".join(f"{RESPONSES[k][2]} {responses[RESPONSES[k][0]]:.3g} {RESPONSES[k][1]} > "
+                     f"{limits[k]:.3g} {RESPONSES[k][1]}"
+                     for k in responses["out_of_range"].split(",") if k)

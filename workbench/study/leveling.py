@@ -45,17 +45,14 @@ from dataclasses import asdict, dataclass
 from typing import Callable
 
 from ..model.limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
-from ..model.validity import validity
+from ..model.validity import RESPONSES, validity
 
 #: The margin below a limit aimed at when a proportional response sets the next force.
 LEVEL_MARGIN = 0.97
 #: The lowest force tried, as a fraction of the study's force_n.
 MIN_FORCE_FRACTION = 1e-3
-#: The limits whose responses follow the force (the next force is scaled by them), and
-#: each limit's column in :func:`workbench.study.metrics.validity`.
+#: The limits whose responses follow the force (the next force is scaled by them).
 PROPORTIONAL = ("tip", "accel", "force")
-RESPONSE_OF = {"tip": "tip_abs_max_cm", "slot": "slide_abs_max_cm",
-               "accel": "accel_abs_max_g", "force": "force1_abs_max_n"}
 
 
 @dataclass(frozen=True)
@@ -76,9 +73,9 @@ class Limits:
         for name, limit in (("accel", self.accel_g), ("force", self.force_transducer_n),
                             ("tip", self.tip_cm)):
             if limit is not None:
-                out[name] = v[RESPONSE_OF[name]] / limit
+                out[name] = v[RESPONSES[name][0]] / limit
         if self.slot:
-            out["slot"] = v[RESPONSE_OF["slot"]] / run.params.s_travel
+            out["slot"] = v[RESPONSES["slot"][0]] / run.params.s_travel
         return out
 
     def exceeded(self, run) -> str | None:
@@ -141,7 +138,7 @@ def level(simulate_at: Callable[..., object], force_max: float, limits: Limits,
             force = math.sqrt(ok[0] * over[0])
         elif ok is None:
             f, _, r = over
-            force = max(floor, min(f / down if name == "slot" else LEVEL_MARGIN * f / value
+            force = max(floor, min(LEVEL_MARGIN * f / value if name in PROPORTIONAL else f / down
                                    for name, value in r.items() if value > 1.0))
             down *= down
         else:
