@@ -333,7 +333,7 @@ def write_report(cases: list[dict], out: Path, wall_s: float,
              f"start, at the default {FORCE_N:g} N and at the lab's level: the "
              f"largest force up to {FORCE_N:g} N at which the accelerometers "
              f"({LAB_LIMITS.accel_g:g} g), the force transducer ({LAB_LIMITS.force_transducer_n:g} N), "
-             f"the tip ({LAB_LIMITS.tip_cm:g} cm) and the slide (the slot's travel) stay within "
+             f"the tip ({10 * LAB_LIMITS.tip_cm:g} mm) and the slide (the slot's travel) stay within "
              "range, found within a factor "
              f"{LAB_LIMITS.resolution:g} (the paper's operator kept the sensors from "
              "saturating; the default shaker study's rule). Records are alias-free (valid to "
@@ -347,7 +347,7 @@ def write_report(cases: list[dict], out: Path, wall_s: float,
                   f"The {O.DRIVE_HZ:g} Hz sine of {SINE_S:g} s from the static equilibrium "
                   f"(measured after {SKIP_S:g} s), cubic cork, at the lab's level (the limit "
                   f"that decided it in brackets) and at {FORCE_N:g} N; 'validated range': whether "
-                  "the whole run kept the tip within 8.4 cm, the slide within the slot's travel "
+                  "the whole run kept the tip within 84 mm, the slide within the slot's travel "
                   "and the sensors within their ranges (the limits it left). The lab observed "
                   "both with sensors that did not saturate (§5.2).", "",
                   gap_table(gap_cases).to_markdown(index=False), ""]

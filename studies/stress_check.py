@@ -20,7 +20,10 @@ from pathlib import Path
 
 import pandas as pd
 
+from workbench.model.shown_units import SI
 
+#: mm per cm: the report gives lengths in mm.
+MM = SI["cm"][1]
 KE_GAIN_REL = 1e-12
 PEN_CM = 1e-8
 
@@ -53,7 +56,7 @@ def main(argv: list[str]) -> int:
     lines = ["# Stress studies: acceptance", "",
              f"Studies: {', '.join(argv[1:])}. Checks per point: finished; no impact raised the "
              f"kinetic energy (> {KE_GAIN_REL:g} of the run's largest); penetration and drift "
-             f"<= {PEN_CM:g} cm (drift: a closed gap after the step's projection; "
+             f"<= {PEN_CM * MM:g} mm (drift: a closed gap after the step's projection; "
              f"the projection's own correction is reported); overtravel past the slot <= "
              f"F/k + sqrt((F/k)^2 + m v^2/k) with F = mu_s x largest normal force, v the "
              f"largest slide speed, m the slide's mass.", "",
@@ -67,10 +70,10 @@ def main(argv: list[str]) -> int:
         "least-violated regimes taken": int(table.least_violated.sum()),
         "Moreau-Jean steps": int(table.stepped_steps.sum()),
         "points with Moreau-Jean steps": int((table.stepped_steps > 0).sum()),
-        "s range (cm)": f"{table.s_min_cm.min():.3f} .. {table.s_max_cm.max():.3f}",
-        "largest penetration (cm)": f"{table.max_penetration_cm.max():.2e}",
-        "largest drift (cm)": f"{table.max_drift_cm.max():.2e}",
-        "largest projection correction (cm)": f"{table.max_correction_cm.max():.2e}",
+        "s range (mm)": f"{table.s_min_cm.min() * MM:.3f} .. {table.s_max_cm.max() * MM:.3f}",
+        "largest penetration (mm)": f"{table.max_penetration_cm.max() * MM:.2e}",
+        "largest drift (mm)": f"{table.max_drift_cm.max() * MM:.2e}",
+        "largest projection correction (mm)": f"{table.max_correction_cm.max() * MM:.2e}",
         "largest overtravel / allowance": f"{(table.stop_overtravel_cm / table.stop_allowance_cm).max():.3f}",
         "wall time of the points (s, sum)": f"{table.wall_s.sum():.0f}",
     }

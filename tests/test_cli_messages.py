@@ -15,7 +15,7 @@ def test_a_run_beyond_the_validated_range_says_so_in_its_json_and_on_stderr(caps
     out, err = capsys.readouterr()
     summary = json.loads(out.strip().splitlines()[-1])
     assert "tip" in summary["out_of_range"] and summary["tip_abs_max_cm"] > 8.4
-    assert "left the range the model is validated for" in err and "8.4 cm" in err
+    assert "left the range the model is validated for" in err and "84 mm" in err
     assert err.count("\n") == 1
     assert cli.main([*RUN, "--force-n", "5", "--duration", "0.3", "--json"]) == 0
     out, err = capsys.readouterr()

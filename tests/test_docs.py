@@ -18,6 +18,7 @@ import shlex
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -59,8 +60,11 @@ def check_lab_files() -> None:
     shaker = [c for c in F.CHANNELS if c != "hammer"]        # a chirp records no hammer
     assert list(tdms.columns) == shaker and tdms.attrs["meta"]["drive"] == "chirp"
     pd.testing.assert_frame_equal(tdms, uff, rtol=1e-9)
-    peaks = pd.read_csv("frf/peaks.csv")
-    assert len(peaks) and peaks.f_hz.between(5, 60).all()
+    modes = pd.read_csv("frf/modes.csv")
+    assert modes.f_hz.between(5, 60).all() and (modes.band_hi_hz == 60).all()
+    hit = pd.read_csv("frf-hit/modes.csv")                 # the locked joint's four modes
+    assert np.allclose(hit.f_hz, [1.969, 13.91, 46.97, 159.75], rtol=3e-3), hit
+    assert hit.zeta_resolved.tolist() == [False, True, True, True]
     assert Path("frf/frf.uff").stat().st_size > 0 and Path("compare/frf.png").exists()
     signals = pd.read_csv("compare/differences_signals.csv")
     assert signals.rms_error_rel.max() < 1e-6        # the file re-makes its run

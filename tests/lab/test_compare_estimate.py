@@ -108,8 +108,8 @@ def test_compare_of_a_chirp_draws_both_spectrograms_and_the_frfs(tmp_path):
         assert (out / f"{name}.png").exists()
     signals = pd.read_csv(out / "differences_signals.csv")
     assert signals.rms_error_rel.max() < 1e-6      # the same model, no noise
-    peaks = pd.read_csv(out / "differences_frf_peaks.csv")
-    assert set(peaks.source) == {"record", "simulation"} and peaks.f_hz.between(5, 65).all()
-    by_source = [peaks[peaks.source == s].drop(columns="source").reset_index(drop=True)
+    modes = pd.read_csv(out / "differences_frf_modes.csv")
+    assert set(modes.source) == {"record", "simulation"} and modes.f_hz.between(5, 65).all()
+    by_source = [modes[modes.source == s].drop(columns="source").reset_index(drop=True)
                  for s in ("record", "simulation")]
-    pd.testing.assert_frame_equal(*by_source, rtol=1e-5)    # the same model: the same peaks
+    pd.testing.assert_frame_equal(*by_source, rtol=1e-5)    # the same model: the same modes

@@ -242,12 +242,13 @@ def test_report_figures_and_tables_of_a_grid(small_run):
     assert all((out / link).exists() for link in links)
     csv = pd.read_csv(out / "tables" / "response.csv")
     merged = csv.merge(table, left_on=["gap_mm", "freq_hz"], right_on=["axis_gap_mm", "axis_freq_hz"])
-    assert len(merged) == 4 and np.allclose(merged.tip_rms_x, merged.tip_rms_y, rtol=1e-12)
+    assert len(merged) == 4 and np.allclose(merged["tip_rms [mm]"], 10 * merged.tip_rms,
+                                            rtol=1e-12)                  # SI: cm -> mm
     md = (out / "tables" / "response.md").read_text()
-    block = md.split("## tip RMS (cm)")[1].split("##")[0]
+    block = md.split("## tip RMS (mm)")[1].split("##")[0]
     assert block.count("*") == (~table.steady).sum()
     for value in table.tip_rms:
-        assert f"{value:.3g}" in block
+        assert f"{10 * value:.3g}" in block
     tex = (out / "tables" / "contact.tex").read_text()
     assert tex.count(r"\begin{table}") == tex.count(r"\end{table}") == 5
     prov = json.loads((out / "provenance.json").read_text())
@@ -314,13 +315,15 @@ gap_mm = [1.016]
     assert (out / "figures" / "spectrogram_gap-1.016mm.png").exists()
     assert "### spectrogram — gap 1.016 mm" in (out / "report.md").read_text()
     assert not (out / "figures" / "frf_map_tip.png").exists()     # no gap x frequency grid
-    long = pd.read_csv(out / "tables" / "response.csv")
-    assert long.tip_rms.iloc[0] == pytest.approx(table.tip_rms.iloc[0], rel=1e-12)
+    long = pd.read_csv(out / "tables" / "response.csv")       # in SI: mm, m/s², µε
+    assert long["tip_rms [mm]"].iloc[0] == pytest.approx(10 * table.tip_rms.iloc[0], rel=1e-12)
+    assert long["accel3_rms [m/s²]"].iloc[0] == pytest.approx(table.accel3_rms.iloc[0] / 100)
+    assert long["strain1_rms [µε]"].iloc[0] == pytest.approx(table.strain1_rms.iloc[0] * 1e6)
     assert (out / "figures" / "frf_gap-1.016mm.png").exists()
-    peaks = pd.read_csv(out / "tables" / "frf_peaks.csv")
-    assert set(peaks.response) <= {"strain1", "accel1", "accel2", "strain2", "accel3"}
-    assert len(peaks) > 0 and peaks.f_hz.between(5.0, 65.0).all()       # the chirp's band
-    assert "frf_peaks.md" in (out / "report.md").read_text()
+    modes = pd.read_csv(out / "tables" / "frf_modes.csv")
+    assert len(modes) > 0 and modes.f_hz.between(5.0, 65.0).all()       # the chirp's band
+    assert (modes.band_lo_hz == 5.0).all() and (modes.band_hi_hz == 65.0).all()
+    assert "frf_modes.md" in (out / "report.md").read_text()
 
 
 def test_a_damaged_point_file_is_set_aside_and_recomputed(small_run, tmp_path, capsys):

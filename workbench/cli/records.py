@@ -62,9 +62,10 @@ def _cmd_compare(args) -> int:
 def _cmd_frf(args) -> int:
     from ..lab.channels import reference_of
     from ..lab.formats import uff
-    from ..lab.frf import (DEFAULT_SEGMENT_S, default_window, frf, magnitude_phase,
-                           peak_table as peak_table_of, responses_of, window_words)
-    from ..present.figures import frf_figure, save
+    from ..lab.frf import (DEFAULT_SEGMENT_S, default_window, frf, magnitude_phase, responses_of,
+                           window_words)
+    from ..lab.modal import MIN_DECAY_TIMES, chart, modes, unresolved_words
+    from ..present.figures import frf_figure, save, stabilisation_chart
 
     if args.f_max is not None and args.f_min >= args.f_max:
         raise ParameterError(f"--f-min {args.f_min:g} Hz must be below --f-max {args.f_max:g} Hz")
@@ -90,23 +91,34 @@ def _cmd_frf(args) -> int:
     table = frf(record, args.response or None, force=force, segment_s=segment_s,
                 skip_s=args.skip_s, window=window)
     responses = responses_of(table)
-    peak_table = peak_table_of({args.file: table}, responses, args.f_min,
-                               args.f_max).drop(columns="source")
+    if args.f_max is not None and args.f_max > table.attrs["band_hz"]:
+        raise ParameterError(f"--f-max {args.f_max:g} Hz: above {args.file}'s valid band; "
+                             f"allowed: (--f-min, {table.attrs['band_hz']:g}] Hz")
+    poles = chart(table, responses, args.f_min, args.f_max, args.order)
+    found = modes(table, poles)
+    notes = unresolved_words(found)
     described = (f"# H1, H2 and coherence of {', '.join(responses)} against {force}, "
                  f"0-{table.attrs['band_hz']:g} Hz (the record's valid band); window: "
                  f"{window_words(table)}\n")
+    band = f"{poles.attrs['band_lo_hz']:g}-{poles.attrs['band_hi_hz']:g} Hz"
     with staged_output(out) as stage:
         with open(stage / "frf.csv", "w") as f:
             f.write(described)
             magnitude_phase(table).to_csv(f)
-        peak_table.to_csv(stage / "peaks.csv", index=False)
-        (stage / "peaks.md").write_text(
-            f"# FRF peaks (H1 against {force}, {window} window): frequency (Hz), magnitude in "
-            "its unit, coherence, half-power damping ratio"
-            + (" (corrected for the exponential window)" if window == "impact" else "")
-            + "\n\n" + peak_table.to_markdown(index=False, floatfmt=".4g") + "\n")
-        save(frf_figure(table, responses, f"{path.name}: H1, H2, coherence against {force} "
-                        f"({window} window)", args.f_max), stage / "frf")
+        found.to_csv(stage / "modes.csv", index=False)
+        (stage / "modes.md").write_text(
+            f"# Modes of {path.name} (H1 of {', '.join(responses)} against {force})\n\n"
+            f"LSCF (sdypy-EMA) over {band}, model orders 2-{2 * poles.attrs['orders']}, read from the "
+            f"stabilisation chart (stabilisation.png); {window_words(table)}. f_hz in Hz; zeta "
+            f"the damping ratio, measured where the record spans at least {MIN_DECAY_TIMES:g} "
+            f"of the mode's decay times (decay_times); contribution: the mode's largest share "
+            f"of a response's largest |H1|.\n\n"
+            + found.to_markdown(index=False, floatfmt=".4g") + "\n"
+            + "".join(f"\n- {n}" for n in notes) + ("\n" if notes else ""))
+        save(frf_figure(table, responses, f"{path.name}: H1 against {force} ({window} window)",
+                        args.f_max, modes=found, f_min=args.f_min), stage / "frf")
+        save(stabilisation_chart(poles, table, found, f"{path.name}: stabilisation chart "
+                                 f"(LSCF, {band})"), stage / "stabilisation")
         uff.write_frf(stage / "frf.uff", table, responses, force, meta=meta,
                       window=window_words(table))
     print(json_text({"record": args.file, "out": str(out), "force": force, "window": window,
@@ -114,8 +126,8 @@ def _cmd_frf(args) -> int:
                      "exp_tau_s": table.attrs.get("exp_tau_s"),
                      "window_words": window_words(table), "band_hz": table.attrs["band_hz"],
                      "resolution_hz": float(table.index[1]), "uff": str(out / "frf.uff"),
-                     "figures": [str(out / f"frf.{ext}") for ext in ("png",)],
-                     "peaks": peak_table.to_dict("records")}))
+                     "figures": [str(out / f"{name}.png") for name in ("frf", "stabilisation")],
+                     "modes": found.to_dict("records"), "notes": notes}))
     return EXIT_OK
 
 
@@ -222,9 +234,15 @@ def add_parsers(sub) -> None:
                     help="Welch segment (s): the frequency resolution is 1/segment (default 2 "
                     "with the Hann window, the whole record with rect and impact)")
     fr.add_argument("--skip-s", type=number(0), default=0.0, help="leave out the first seconds")
-    fr.add_argument("--f-min", type=number(0), default=0.0, help="lowest peak frequency (Hz)")
+    fr.add_argument("--f-min", type=number(0), default=0.0,
+                    help="lower end of the band the modes are fitted in (Hz)")
     fr.add_argument("--f-max", type=number(0, lo_open=True), default=None,
-                    help="highest frequency shown and searched for peaks (Hz)")
+                    help="upper end of the band shown and fitted (Hz; default the record's "
+                    "valid band, 0.4 of its sample rate)")
+    fr.add_argument("--order", type=number(2, 200, integer=True), default=None,
+                    help="highest model order of the LSCF fit: orders 2, 4, ... 2 x ORDER "
+                    "(default 40, lab.modal.ORDER, or a quarter of the band's frequency lines if "
+                    "fewer)")
     fr.add_argument("--strain-scale", metavar="CHANNEL=K", action="append", default=[],
                     help="scale factor of a strain channel recorded in V (strain per volt)")
     add_format_option(fr)

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..model.limits import DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_OUTPUT_HZ, MIN_DT
 from ..model.params import ParameterError, describe
+from ..model.shown_units import SI
 from ..study.paths import check_output_file
 from .common import (EXIT_INTERNAL, EXIT_OK, EXIT_RUN_FAILED, add_drive_options, add_joint_options,
                      add_model_options, json_text, number, parameters_of,
@@ -145,7 +146,8 @@ def _cmd_run(args) -> int:
     return EXIT_OK if run.ok else EXIT_RUN_FAILED
 
 
-#: The keys of a run's summary the human-readable output shows, with their units.
+#: The keys of a run's summary the human-readable output shows, with their units (a CGS unit of
+#: :data:`~workbench.model.shown_units.SI` is shown in SI, the key without its unit suffix).
 HUMAN_KEYS = (("status", ""), ("message", ""), ("simulated_s", "s"), ("wall_s", "s"),
               ("method", ""), ("tol", ""), ("steps", ""), ("rejected", ""),
               ("error_over_tol_max", "of the tolerance"), ("n_events", ""), ("n_impacts", ""),
@@ -176,8 +178,12 @@ def human_summary(summary: dict, out=None) -> str:
             value = summary[key]
             if key == "contact_time_share":
                 value = {k: v for k, v in sorted(value.items(), key=lambda kv: -kv[1]) if v >= 0.01}
+            name = key
+            if unit in SI and SI[unit][0] != unit:
+                name, (unit, factor) = key.removesuffix(f"_{unit}"), SI[unit]
+                value = value * factor
             text = _plain(value) if value not in ("", None) else "-"
-            lines.append(f"{key:>20}: {text}{' ' + unit if unit and text != '-' else ''}")
+            lines.append(f"{name:>20}: {text}{' ' + unit if unit and text != '-' else ''}")
     if out:
         lines.append(f"{'wrote':>20}: {out}")
     return "\n".join(lines)

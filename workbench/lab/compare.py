@@ -11,8 +11,8 @@ draws the paper's comparisons from these and writes them:
 4. for chirps, spectrograms of strain1 (Fig. 11-12);
 5. for chirps, the FRFs (H1 and coherence of each acceleration and strain
    against force1, :mod:`workbench.lab.frf`), simulation over
-   record, with the peaks of each in the chirp's band (a sine's force has
-   no band to refer a response to).
+   record, with the modes of each in the chirp's band (:mod:`workbench.lab.modal`;
+   a sine's force has no band to refer a response to).
 
 The differences (``differences.csv``/``.md``), over the comparison window:
 
@@ -23,8 +23,8 @@ The differences (``differences.csv``/``.md``), over the comparison window:
   the nearest peak of the simulation: their frequencies and shift (Hz);
 * per contact code, the share of time in the record and in the simulation
   and their difference;
-* for chirps, the FRF peaks of record and simulation: frequency, |H1|, coherence and
-  half-power damping ratio.
+* for chirps, the modes of the record's and the simulation's FRFs: frequency,
+  damping ratio (LSCF, :mod:`workbench.lab.modal`).
 """
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ class Comparison:
     peaks: pd.DataFrame         # channel, rank -> record / simulation peak, shift
     contacts: pd.DataFrame      # code -> shares, difference
     figures: list
-    frf_peaks: pd.DataFrame | None = None     # source, response -> FRF peaks
+    frf_modes: pd.DataFrame | None = None     # source -> modes of the FRFs (lab.modal)
     notes: list = field(default_factory=list)
 
 

@@ -34,13 +34,12 @@ The window (:data:`WINDOWS`) is the modal engineer's choice per kind of test
   rest, and an exponential window exp(-(t - t_hit) / tau) on the response
   from the hit, tau such that it has fallen to EXP_END at the record's end.
   The response's level before the hit (a static offset) is removed first.
-  The exponential window adds 1 / tau to every mode's decay rate, so the
-  half-power damping is corrected by zeta = zeta_measured - 1 / (tau omega_n)
-  (Fladung & Rost, eq. 9); one hit has no coherence (NaN).
+  The exponential window adds 1 / tau to every mode's decay rate (Fladung &
+  Rost, eq. 9), which :mod:`workbench.lab.modal` takes back from the poles it
+  fits; one hit has no coherence (NaN).
 
-The peaks of |H1| give the natural frequencies and, by the half-power
-bandwidth, the damping ratios: zeta = (f_b - f_a) / (2 f_n) with
-|H1(f_a)| = |H1(f_b)| = |H1(f_n)| / sqrt 2 (interpolated linearly).
+Modal parameters (natural frequencies, damping ratios) are read from these
+tables by :mod:`workbench.lab.modal` (LSCF and a stabilisation chart).
 """
 from __future__ import annotations
 
@@ -65,9 +64,6 @@ EXP_END = 0.01
 #: 1 m/s^2 = 100 cm/s^2.
 FIELD_UNITS = {"strain": ("µε/N", 1e6 * 1e5), "accel": ("(m/s²)/N", 1e5 / 100.0)}
 
-
-#: The columns of a response's peak table.
-PEAK_COLUMNS = ["f_hz", "magnitude", "unit", "coherence", "zeta_half_power"]
 
 
 def field_unit(response: str) -> tuple[str, float]:
@@ -95,7 +91,7 @@ def frf(record: pd.DataFrame, responses=None, force: str = "force1",
     record).  Returns a DataFrame indexed by frequency (Hz) with, per
     response r, the columns ``r_H1``, ``r_H2`` (complex) and
     ``r_coherence``; ``attrs`` holds the window and, for ``impact``, the
-    exponential window's ``exp_tau_s`` (s) that :func:`peaks` corrects the
+    exponential window's ``exp_tau_s`` (s) that the modal fit corrects the
     damping for.  The frequencies stop at ``band_hz``, by default the record's valid band,
     PASSBAND of its sample rate (an anti-aliased record's, as the workbench writes them and
     a DAQ records them).  Raises ParameterError on a record it cannot use.
@@ -174,8 +170,8 @@ def window_words(table: pd.DataFrame) -> str:
     a = table.attrs
     if a.get("window") == "impact":
         return (f"force window on the hit and exponential window, tau = {a['exp_tau_s']:.6g} s "
-                f"(a fitted damping ratio reads 1/(2 pi f tau) too high: subtract it; peaks "
-                f"are corrected)")
+                f"(a fitted damping ratio reads 1/(2 pi f tau) too high: subtract it; the "
+                f"modes are corrected)")
     shape = "Hann" if a.get("window") == "hann" else "rectangular (none)"
     return (f"{shape} window, {a.get('averages', 1)} average(s) of {a.get('segment_s', 0):.6g} s "
             f"segments{', half overlap' if a.get('window') == 'hann' else ''}; no damping "
@@ -214,60 +210,6 @@ def _impact_frf(t, force, responses: dict) -> pd.DataFrame:
     table = pd.DataFrame(out, index=pd.Index(freq, name="f_hz"))
     table.attrs.update(window="impact", averages=1, exp_tau_s=tau, segment_s=n * (t[1] - t[0]))
     return table
-
-
-def peaks(frf_table: pd.DataFrame, response: str, f_min: float = 0.0, f_max: float | None = None,
-          prominence: float = 0.1, estimate: str = "H1") -> pd.DataFrame:
-    """The resonance peaks of |H| of one response: frequency (Hz), |H| in the field's unit
-    (:data:`FIELD_UNITS`) and that unit, coherence, and the half-power damping ratio (NaN
-    where a half-power point lies outside the band).
-
-    ``prominence`` is relative to the largest |H| in the band (log scale: a
-    peak must stand out by that fraction of a decade).  After the impact
-    window the damping is corrected for the exponential window's decay
-    (module docstring)."""
-    tau = frf_table.attrs.get("exp_tau_s")
-    f = frf_table.index.to_numpy()
-    band = (f >= f_min) & (f <= (f_max if f_max is not None else f[-1])) & (f > 0)
-    mag = np.abs(frf_table[f"{response}_{estimate}"].to_numpy())[band]
-    coh = frf_table[f"{response}_coherence"].to_numpy()[band]
-    fb = f[band]
-    unit, scale = field_unit(response)
-    if not np.any(mag > 0):
-        return pd.DataFrame(columns=PEAK_COLUMNS)
-    logm = np.log10(np.where(mag > 0, mag, mag[mag > 0].min()))
-    idx, _ = signal.find_peaks(logm, prominence=prominence)
-    rows = []
-    for i in idx:
-        level = mag[i] / np.sqrt(2.0)
-        lo = i
-        while lo > 0 and mag[lo] > level:
-            lo -= 1
-        hi = i
-        while hi < len(mag) - 1 and mag[hi] > level:
-            hi += 1
-        zeta = np.nan
-        if mag[lo] <= level and mag[hi] <= level and lo < i < hi:
-            fa = np.interp(level, [mag[lo], mag[lo + 1]], [fb[lo], fb[lo + 1]])
-            fbb = np.interp(level, [mag[hi], mag[hi - 1]], [fb[hi], fb[hi - 1]])
-            zeta = (fbb - fa) / (2.0 * fb[i])
-            if tau:
-                zeta -= 1.0 / (tau * 2.0 * np.pi * fb[i])
-        rows.append({"f_hz": float(fb[i]), "magnitude": float(mag[i]) * scale, "unit": unit,
-                     "coherence": float(coh[i]), "zeta_half_power": float(zeta)})
-    return pd.DataFrame(rows, columns=PEAK_COLUMNS)
-
-
-def peak_table(tables: dict[str, pd.DataFrame], responses, f_min: float = 0.0,
-               f_max: float | None = None) -> pd.DataFrame:
-    """The H1 peaks of each response of each FRF table ({source: table}), one row per
-    peak: source, response, f_hz, magnitude and its unit (the field's, :data:`FIELD_UNITS`),
-    coherence, zeta_half_power."""
-    rows = [peaks(table, r, f_min, f_max).assign(source=source, response=r)
-            for source, table in tables.items() for r in responses]
-    columns = ["source", "response", *PEAK_COLUMNS]
-    rows = [r for r in rows if len(r)]
-    return pd.concat(rows, ignore_index=True)[columns] if rows else pd.DataFrame(columns=columns)
 
 
 def responses_of(table: pd.DataFrame) -> list[str]:

@@ -52,6 +52,23 @@ def contact_code(regime):
     return int(codes) if codes.ndim == 0 else codes
 
 
+#: Where each contact point is (docs/model.md §7, Fig. 4), in words.
+POINT_WORDS = {1: "inner end on the lower plate", 2: "inner end on the upper plate",
+               3: "lower lip on the body", 4: "upper lip on the body"}
+
+
+def code_words(code: int) -> str:
+    """The paper's contact code in words: '0 free flight', '13 points 1+3 (inner end on the
+    lower plate, lower lip on the body)'."""
+    if code == 0:
+        return "0 free flight"
+    points = [int(c) for c in str(code)]
+    if len(points) == 1:
+        return f"{code} point {code} ({POINT_WORDS[code]})"
+    return (f"{code} points {'+'.join(map(str, points))} "
+            f"({', '.join(POINT_WORDS[p] for p in points)})")
+
+
 def regime_name(regime: int) -> str:
     """'free', or e.g. 'stick {2,3}' / 'slip {1}' (points 1-based)."""
     if regime == 0:

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .shown_units import SI
+
 from ..core import layout as ly
 from .limits import ACCEL_RANGE_G, FORCE_RANGE_N, VALID_TIP_CM
 
@@ -41,7 +43,8 @@ def accel_peak_g(run) -> float:
                      for c in ("accel1", "accel2", "accel3"))) / G_CM_S2
 
 
-#: Each limit of the validated range: its response's column, unit and name in words.
+#: Each limit of the validated range: its response's column, unit and name in words.  The words
+#: give lengths in mm (SI as the field writes them, :data:`~workbench.model.shown_units.SI`).
 RESPONSES = {"tip": ("tip_abs_max_cm", "cm", "tip deflection"),
              "slot": ("slide_abs_max_cm", "cm", "slide"),
              "accel": ("accel_abs_max_g", "g", "acceleration"),
@@ -70,6 +73,10 @@ def validity(run) -> dict:
 def exceeded_words(responses: dict, params) -> str:
     """Each limit ``responses`` (validity's columns) exceed, with value and limit, in words."""
     limits = validated_limits(params)
-    return "; ".join(f"{RESPONSES[k][2]} {responses[RESPONSES[k][0]]:.3g} {RESPONSES[k][1]} > "
-                     f"{limits[k]:.3g} {RESPONSES[k][1]}"
-                     for k in responses["out_of_range"].split(",") if k)
+    words = []
+    for k in filter(None, responses["out_of_range"].split(",")):
+        column, unit, name = RESPONSES[k]
+        shown, factor = SI[unit]
+        words.append(f"{name} {responses[column] * factor:.3g} {shown} > "
+                     f"{limits[k] * factor:.3g} {shown}")
+    return "; ".join(words)

@@ -3,7 +3,7 @@
 The paper's comparisons (seed §6) of :mod:`workbench.lab.compare`,
 drawn and written into a folder: time-history overlay (Fig. 6), power
 spectra (Fig. 7-8), contact switching diagrams (Fig. 9-10), for chirps
-spectrograms of strain1 (Fig. 11-12) and the FRFs with their peaks; and
+spectrograms of strain1 (Fig. 11-12) and the FRFs with their modes; and
 the tables of differences (``differences_*.csv``, ``differences.md``).
 """
 from __future__ import annotations
@@ -16,7 +16,8 @@ from ..lab.channels import kind
 from ..lab.compare import (DEFAULT_THRESHOLD_V, SIGNALS, Comparison, code_series,
                                    contact_differences, peak_shifts, signal_differences, window)
 from ..lab.files import record_from_run
-from ..lab.frf import default_window, frf, peak_table
+from ..lab.frf import default_window, frf
+from ..lab.modal import mode_table
 from ..model.params import ParameterError
 from . import figures as F
 
@@ -25,7 +26,7 @@ def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
             threshold=DEFAULT_THRESHOLD_V, seconds: float = 0.5, chirp: bool = False,
             band: tuple[float, float] | None = None, title: str = "") -> Comparison:
     """Compare ``record`` with a simulated ``run`` and write figures and tables into ``out``;
-    ``band`` (Hz) limits the FRF peaks to where the drive has force (a chirp's band)."""
+    ``band`` (Hz) limits the FRFs' modal fit to where the drive has force (a chirp's band)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     sim = record_from_run(run)
@@ -53,24 +54,27 @@ def compare(record: pd.DataFrame, run, out: str | Path, *, skip_s: float = 0.0,
                                      out / f"spectrogram_{name}")
     responses = [c for c in channels if kind(c) in ("accel", "strain")]
     if chirp and "force1" in rec_w.columns and responses:
+        f_lo, f_hi = band or (0.0, None)
         try:
             tables = {name: frf(rec, responses, segment_s=None, window=default_window("chirp"))
                       for name, rec in sources.items()}
         except ParameterError as exc:
             result.notes.append(f"FRFs not computed: {exc}")
         else:
-            f_lo, f_hi = band or (0.0, None)
-            result.frf_peaks = peak_table(tables, responses, f_lo, f_hi)
+            try:
+                result.frf_modes = mode_table(tables, responses, f_lo, f_hi)
+            except ParameterError as exc:
+                result.notes.append(f"FRF modes not identified: {exc}")
             result.figures += F.save(F.frf_figure(tables, responses, f"{title}: H1 against force1",
-                                                  1.2 * f_hi if f_hi else None), out / "frf")
+                                                  f_hi, f_min=f_lo), out / "frf")
     _write_tables(result, out, title)
     return result
 
 
 def _write_tables(result: Comparison, out: Path, title: str) -> None:
     tables = {"signals": result.signals, "peaks": result.peaks, "contacts": result.contacts}
-    if result.frf_peaks is not None:
-        tables["frf_peaks"] = result.frf_peaks
+    if result.frf_modes is not None:
+        tables["frf_modes"] = result.frf_modes
     md = [f"# Comparison: {title}", ""] + [f"{note}\n" for note in result.notes]
     for name, table in tables.items():
         table.to_csv(out / f"differences_{name}.csv", index=False)

@@ -7,6 +7,10 @@ import pandas as pd
 
 from ..model.accuracy import ERROR_BOUND
 from ..study.grid import point_title
+from .units import si
+
+#: mm per cm: lengths are reported in mm (:mod:`workbench.present.units`).
+MM = si("cm")[1]
 
 
 def accuracy_lines(study, table: pd.DataFrame) -> list[str]:
@@ -65,21 +69,22 @@ def range_lines(table: pd.DataFrame) -> list[str]:
     ok = table[table.status == "ok"]
     over = ok[ok.out_of_range.fillna("") != ""]
     count = (f"{len(ok) - len(over)} of {len(ok)} points lie inside the validated range (tip "
-             "within 8.4 cm of its static position, the slide within the slot's travel, the "
+             "within 84 mm of its static position, the slide within the slot's travel, the "
              "sensors within their ranges")
     if not len(over):
         return [count + ").", ""]
     kinds = pd.Series([k for v in over.out_of_range for k in v.split(",")]).value_counts()
     lines = ["## Points outside the validated range", "",
              count + f"; outside: {', '.join(f'{k} at {n}' for k, n in kinds.items())}).", "",
-             "The tip beyond the paper's 8.4 cm (§5.3; the beams' small-slope shapes were "
+             "The tip beyond the paper's 84 mm (§5.3; the beams' small-slope shapes were "
              "compared with the rig up to there), the slide beyond the slot's travel (the "
              "end stop, an ASSUMPTION, carries it), or a sensor beyond its range (50 g, "
              "2224 N: a lab's record would be clipped). Marked '!' in the maps.", "",
-             "| point | outside | tip max (cm) | slide max (cm) | accel max (g) | force1 max (N) |",
+             "| point | outside | tip max (mm) | slide max (mm) | accel max (g) | force1 max (N) |",
              "|---|---|---|---|---|---|"]
-    lines += [f"| {point_title(r)} | {r.out_of_range} | {r.tip_abs_max_cm:.3g} | "
-              f"{r.slide_abs_max_cm:.3g} | {r.accel_abs_max_g:.3g} | {r.force1_abs_max_n:.3g} |"
+    lines += [f"| {point_title(r)} | {r.out_of_range} | {r.tip_abs_max_cm * MM:.3g} | "
+              f"{r.slide_abs_max_cm * MM:.3g} | {r.accel_abs_max_g:.3g} | "
+              f"{r.force1_abs_max_n:.3g} |"
               for _, r in over.iterrows()]
     return lines + [""]
 
@@ -93,7 +98,7 @@ def level_lines(study, table: pd.DataFrame) -> list[str]:
     ok = table[table.status == "ok"]
     named = [f"accelerometers {lim.accel_g:g} g" if lim.accel_g else "",
              f"force transducer {lim.force_transducer_n:g} N" if lim.force_transducer_n else "",
-             f"tip {lim.tip_cm:g} cm" if lim.tip_cm else "",
+             f"tip {lim.tip_cm * MM:g} mm" if lim.tip_cm else "",
              "the slide within the slot's travel" if lim.slot else ""]
     lines = ["## Each point's force", "",
              f"Each point's force is the largest, up to {study.excitation['force_n']:g} N, at "
@@ -111,10 +116,10 @@ def level_lines(study, table: pd.DataFrame) -> list[str]:
     lines.append("")
     if len(unmet):
         lines += [f"{len(unmet)} points meet the limits at no force tried:", "",
-                  "| point | lowest force (N) | runs | limit | tip max (cm) | slide max (cm) | "
+                  "| point | lowest force (N) | runs | limit | tip max (mm) | slide max (mm) | "
                   "accel max (g) |", "|---|---|---|---|---|---|---|"]
         lines += [f"| {point_title(r)} | {r.force_n_used:.3g} | {int(r.level_runs)} | "
-                  f"{r.level_limit} | {r.tip_abs_max_cm:.3g} | {r.slide_abs_max_cm:.3g} | "
+                  f"{r.level_limit} | {r.tip_abs_max_cm * MM:.3g} | {r.slide_abs_max_cm * MM:.3g} | "
                   f"{r.accel_abs_max_g:.3g} |" for _, r in unmet.iterrows()]
         lines.append("")
     return lines

@@ -12,8 +12,8 @@ sine drive over several frequencies; every point with a saved time series
 gets a time history, strain spectra and a switching diagram, and a chirp a
 spectrogram and its FRFs (H1 and coherence of every acceleration and strain
 against force1 over one record-long rectangular window, the chirp's,
-:mod:`workbench.lab.frf`) as well, with their peaks
-in ``tables/frf_peaks.{csv,md}``.
+:mod:`workbench.lab.frf`) as well, with their modes (:mod:`workbench.lab.modal`)
+in ``tables/frf_modes.{csv,md,tex}``.
 """
 from __future__ import annotations
 
@@ -30,9 +30,10 @@ from ..study.store import read_runs, write_text_atomic
 from ..model import drives
 from ..study.definition import Study
 from .point_checks import accuracy_lines, level_lines, range_lines
-from .tables import write_frf_peaks, write_tables
+from .tables import write_frf_modes, write_tables
 from ..lab.channels import CHANNELS, kind
-from ..lab.frf import default_window, frf, peak_table
+from ..lab.frf import default_window, frf
+from ..lab.modal import mode_table
 
 #: The channels whose FRF against force1 a chirp's report shows.
 RESPONSES = tuple(c for c in CHANNELS if kind(c) in ("accel", "strain"))
@@ -57,9 +58,9 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     return figs
 
 
-def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
+def _series_figures(study: Study, row, tag: str, out: Path, frf_modes: list):
     """(name, figure builder) of one point's saved series (none if it has no series),
-    each name ``<figure>_<tag>``; a chirp's FRF peaks are added to ``frf_peaks``."""
+    each name ``<figure>_<tag>``; a chirp's FRF modes are added to ``frf_modes``."""
     path = out / "series" / f"{row.key}.parquet"
     if not path.exists():
         return
@@ -78,10 +79,11 @@ def _series_figures(study: Study, row, tag: str, out: Path, frf_peaks: list):
         responses = [c for c in sig.columns if c in RESPONSES]
         f_lo, f_hi = drives.band_hz(study.excitation)
         tables = {title: frf(sig, responses, segment_s=None, window=default_window("chirp"))}
-        frf_peaks.append(peak_table(tables, responses, f_lo, f_hi))
+        found = mode_table(tables, responses, f_lo, f_hi)
+        frf_modes.append(found)
         yield f"frf_{tag}", lambda: F.frf_figure(tables[title], responses,
-                                                 f"{title}: H1, H2, coherence against force1",
-                                                 f_max=1.2 * f_hi)
+                                                 f"{title}: H1 against force1", f_max=f_hi,
+                                                 modes=found, f_min=f_lo)
 
 
 #: Relative cost of drawing a grid figure (a series unit is 1): the order of the tasks.
@@ -116,14 +118,14 @@ def _draw(study: Study, table: pd.DataFrame, out: Path, unit) -> tuple[dict, lis
     """Draw and save one unit of the report: a grid figure (its name) or the
     figures of one point's series (its row number and tag).  Returns the
     figures made {name: paths} and the FRF peak tables."""
-    frf_peaks: list = []
+    frf_modes: list = []
     if isinstance(unit, str):
         builders = [(unit, _grid_figures(study, table)[unit])]
     else:
         row, tag = unit
-        builders = _series_figures(study, table.iloc[row], tag, out, frf_peaks)
+        builders = _series_figures(study, table.iloc[row], tag, out, frf_modes)
     made = {name: F.save(build(), out / "figures" / name) for name, build in builders}
-    return made, frf_peaks
+    return made, frf_modes
 
 
 def make_report(study: Study, results: str | Path = "results", jobs: int = 1) -> Path:
@@ -154,10 +156,10 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
     else:
         drawn = [_draw(study, table, out, u) for u in units]
     made = {name: paths for figures, _ in drawn for name, paths in figures.items()}
-    frf_peaks = [peaks for _, found in drawn for peaks in found]
+    frf_modes = [modes for _, found in drawn for modes in found]
     tables = write_tables(table, out / "tables")
-    if frf_peaks:
-        tables += write_frf_peaks(pd.concat(frf_peaks, ignore_index=True), out / "tables")
+    if frf_modes:
+        tables += write_frf_modes(pd.concat(frf_modes, ignore_index=True), out / "tables")
     report_wall = time.perf_counter() - t0
     provenance = {**environment(), "study": study_definition(study),
                   "points": summary(table), "report_wall_s": report_wall,
@@ -206,10 +208,12 @@ def render_index(study, table, figures, tables, out) -> str:
     lines += accuracy_lines(study, table)
     lines += level_lines(study, table)
     lines += range_lines(table)
-    lines += ["## Tables", ""]
-    for p in tables:
-        lines.append(f"- [{p.name}]({p.relative_to(out)})")
-    lines += ["", "## Figures", ""]
+    if tables:
+        lines += ["## Tables", "", "Values in SI (N, m/s², µε, mm), each column's unit in its "
+                  "header; the points table keeps the model's CGS.", ""]
+        lines += [f"- [{p.name}]({p.relative_to(out)})" for p in tables] + [""]
+    if figures:
+        lines += ["## Figures", ""]
     labels = dict(zip(series_tags(table), (point_label(row) for _, row in table.iterrows())))
     for name, paths in figures.items():
         png, pdf = (p.relative_to(out) for p in paths)

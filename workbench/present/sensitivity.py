@@ -37,6 +37,7 @@ import pandas as pd
 from . import figures as F
 from .point_checks import accuracy_lines, range_lines
 from . import observations as O
+from . import units
 from ..model.modes import natural_frequencies
 from ..study.provenance import environment
 from ..study.sensitivity import indices
@@ -49,10 +50,10 @@ OUTPUTS = (
     ("share_13", "time share of code 13", "Fig. 9-10"),
     ("switches_per_s", "contact switches per s", "Fig. 9-10"),
     ("strain1_sub_db", "strain1 line at half the drive over its floor (dB)", "Fig. 7-8"),
-    ("strain1_h1", "strain1 amplitude at the drive frequency", "Fig. 6"),
-    ("strain2_h1", "strain2 amplitude at the drive frequency", "Fig. 6"),
-    ("accel1_h1", "accel1 amplitude at the drive frequency (cm/s²)", "Fig. 6"),
-    ("accel3_h1", "accel3 amplitude at the drive frequency (cm/s²)", "Fig. 6"),
+    ("strain1_h1", "strain1 amplitude at the drive frequency (µε)", "Fig. 6"),
+    ("strain2_h1", "strain2 amplitude at the drive frequency (µε)", "Fig. 6"),
+    ("accel1_h1", "accel1 amplitude at the drive frequency (m/s²)", "Fig. 6"),
+    ("accel3_h1", "accel3 amplitude at the drive frequency (m/s²)", "Fig. 6"),
     ("band1_min", "chirp band of the first locked mode above 5 Hz (min)", "Fig. 11-12, proxy"),
     ("band2_min", "chirp band of the second locked mode above 5 Hz (min)", "Fig. 11-12, proxy"),
 )
@@ -89,7 +90,8 @@ def band_times(params) -> tuple[float, float]:
 
 def design_table(study, table: pd.DataFrame) -> pd.DataFrame:
     """The points table in the design's row order, every output and indicator as a column
-    (NaN where a point failed), the band proxies added.  Two rows of the design can be one
+    (NaN where a point failed; amplitudes in SI, :mod:`workbench.present.units`), the band
+    proxies added.  Two rows of the design can be one
     point (a choice drawn the same from both matrices): the sweep keeps one result for them,
     under the index (``chain``) of either, and both rows take it."""
     twins: dict = {}
@@ -110,6 +112,8 @@ def design_table(study, table: pd.DataFrame) -> pd.DataFrame:
     rows["band1_min"], rows["band2_min"] = bands[:, 0], bands[:, 1]
     for col, _, _ in OUTPUTS:
         rows.loc[~ok, col] = np.nan
+        if col.endswith("_h1"):                       # the points table's CGS -> SI
+            rows[col] = rows[col] * units.channel(col.removesuffix("_h1"))[1]
     for name, (_, rule) in HOLDS.items():
         holds = rule(rows).astype(float)
         rows[f"holds_{name}"] = holds.where(ok)

@@ -3,18 +3,19 @@
 Two tables, each per gap x drive frequency with a block per value of the
 other axes (tip mass, cork, ...):
 
-- ``response``: RMS of the tip displacement (cm), of strain1 and accel3,
-  and the amplitude at the drive frequency;
+- ``response``: RMS of the tip displacement (mm), of strain1 (µε) and
+  accel3 (m/s²), and the tip's amplitude at the drive frequency (mm);
 - ``contact``: impacts and regime switches per second, stick share, the
   share of free flight and the dominant contact code.
 
-The CSV is long (one row per point, every column, ``steady`` and
-``status`` included).  The Markdown and LaTeX tables pivot one quantity per
+Values are in SI (:mod:`workbench.present.units`; the points table keeps
+CGS).  The CSV is long (one row per point, every column with its unit in the
+header, ``steady`` and ``status`` included).  The Markdown and LaTeX tables pivot one quantity per
 block: gap rows, frequency columns; ``*`` marks a point that is not steady,
 ``!`` one whose response left the validated range (``out_of_range`` in the
 CSV: ``metrics.validity``) and ``failed`` one that did not finish.  A study without both axes gets
-the long table in every format.  A study of chirps also gets ``frf_peaks``,
-the peaks of each point's FRFs (:func:`write_frf_peaks`).
+the long table in every format.  A study of chirps also gets ``frf_modes``,
+the modes of each point's FRFs (:func:`write_frf_modes`).
 """
 from __future__ import annotations
 
@@ -23,12 +24,13 @@ from pathlib import Path
 import pandas as pd
 
 from ..study.metrics import CONTACT_CODES, QUANTITIES
+from . import units
 from ..study.grid import label, panels
 
 TABLES = {
-    "response": {k: QUANTITIES[k] for k in ("tip_rms", "tip_h1", "strain1_rms", "accel3_rms")},
-    "contact": {**{k: QUANTITIES[k] for k in ("impacts_per_s", "switches_per_s", "stick_share",
-                                              "share_0")},
+    "response": {k: units.quantity_label(k) for k in ("tip_rms", "tip_h1", "strain1_rms", "accel3_rms")},
+    "contact": {**{k: units.quantity_label(k) for k in ("impacts_per_s", "switches_per_s", "stick_share",
+                                                  "share_0")},
                 "dominant_code": "dominant contact code"},
 }
 PIVOT = ("gap_mm", "freq_hz")
@@ -42,12 +44,14 @@ def with_dominant_code(table: pd.DataFrame) -> pd.DataFrame:
     return table.assign(dominant_code=codes)
 
 
-def cell(row, quantity: str) -> str:
-    """A point's value as printed: 3 significant digits, '*' if not steady, '!' if outside
-    the validated range."""
+def cell(row, name: str) -> str:
+    """A point's value as printed, in SI (:mod:`workbench.present.units`): 3 significant
+    digits, '*' if not steady, '!' if outside the validated range."""
     if row.status != "ok":
         return "failed"
-    v = row[quantity]
+    v = row[name]
+    if isinstance(v, float) and name in QUANTITIES:
+        v *= units.quantity(name)[2]
     text = f"{v:.3g}" if isinstance(v, float) else str(v)
     text = text if bool(row.steady) else text + "*"
     return text + "!" if row.get("out_of_range", "") else text
@@ -74,12 +78,23 @@ def latex_text(text: str) -> str:
     return text
 
 
+def latex_units(text: str) -> str:
+    """The SI units' characters as LaTeX math: m/s², µε."""
+    return text.replace("²", "$^2$").replace("µε", r"$\mu\varepsilon$")
+
+
 def _long(table: pd.DataFrame, columns: dict) -> pd.DataFrame:
+    """One row per point: its axes, status and the columns, in SI with the unit in each
+    column's header (``tip_rms [mm]``)."""
     axes = [c for c in table.columns if c.startswith("axis_")]
     keep = axes + [c for c in ("status", "message", "steady", "steady_change", "out_of_range",
                                *columns)
                    if c in table]
-    return table[keep].rename(columns={c: c[5:] for c in axes})
+    out = table[keep].copy()
+    for c in columns:
+        if c in out and c in QUANTITIES:
+            out[c] = out[c] * units.quantity(c)[2]
+    return out.rename(columns={**{c: c[5:] for c in axes}, **{c: units.column(c) for c in columns}})
 
 
 def write_tables(table: pd.DataFrame, out: Path) -> list[Path]:
@@ -107,20 +122,23 @@ def write_tables(table: pd.DataFrame, out: Path) -> list[Path]:
             md.append(long.to_markdown(index=False, floatfmt=".4g"))
             tex.append(long.to_latex(index=False, float_format="%.4g", escape=True))
         (out / f"{name}.md").write_text("\n".join(md) + "\n")
-        (out / f"{name}.tex").write_text("\n".join(tex).replace("²", "$^2$"))
+        (out / f"{name}.tex").write_text(latex_units("\n".join(tex)))
         written += [csv, out / f"{name}.md", out / f"{name}.tex"]
     return written
 
 
-def write_frf_peaks(peaks: pd.DataFrame, out: Path) -> list[Path]:
-    """The FRF peaks of a study's chirps (``frf_peaks.{csv,md,tex}``); return the paths."""
+def write_frf_modes(modes: pd.DataFrame, out: Path) -> list[Path]:
+    """The modes of a study's chirps' FRFs (``frf_modes.{csv,md,tex}``, one row per point and
+    mode, :mod:`workbench.lab.modal`); return the paths."""
+    from ..lab.modal import MIN_DECAY_TIMES
     out.mkdir(parents=True, exist_ok=True)
-    peaks = peaks.rename(columns={"source": "point"})
-    caption = ("FRF peaks (H1 against force1): frequency (Hz), |H1| in its unit (µε/N, (m/s²)/N), "
-               "coherence, half-power damping ratio")
-    paths = [out / f"frf_peaks.{ext}" for ext in ("csv", "md", "tex")]
-    peaks.to_csv(paths[0], index=False)
-    paths[1].write_text(f"# {caption}\n\n{peaks.to_markdown(index=False, floatfmt='.4g')}\n")
-    paths[2].write_text(peaks.to_latex(index=False, float_format="%.4g", escape=True,
+    modes = modes.rename(columns={"source": "point"})
+    caption = ("Modes of the FRFs (H1 against force1; LSCF and a stabilisation chart): frequency "
+               "f_hz (Hz), damping ratio zeta (empty where the record spans fewer than "
+               f"{MIN_DECAY_TIMES:g} of the mode's decay times), the band fitted (Hz)")
+    paths = [out / f"frf_modes.{ext}" for ext in ("csv", "md", "tex")]
+    modes.to_csv(paths[0], index=False)
+    paths[1].write_text(f"# {caption}\n\n{modes.to_markdown(index=False, floatfmt='.4g')}\n")
+    paths[2].write_text(modes.to_latex(index=False, float_format="%.4g", escape=True,
                                        caption=latex_text(caption)))
     return paths

@@ -52,12 +52,14 @@ HARMONICS = (0.5, 1.0, 2.0, 3.0)
 CONTACT_CODES = regimes.CONTACT_CODES
 DISSIPATION = {"structural": "d_structural", "cork": "d_cork", "friction": "d_friction",
                "impact": "d_impact"}
-#: Printed names (with units) of the metrics shown in figures and tables.
+#: The metrics shown in figures and tables: (title, CGS unit of the column; "" for a count or a
+#: share).  ``workbench.present.units`` shows them in SI.
 QUANTITIES = {
-    "tip_rms": "tip RMS (cm)", "tip_h1": "tip at f (cm)", "strain1_rms": "strain1 RMS (-)",
-    "accel3_rms": "accel3 RMS (cm/s²)", "impacts_per_s": "impacts per s",
-    "switches_per_s": "switches per s", "stick_share": "stick share",
-    "share_0": "free-flight share", "force_n_used": "drive force used (N)",
+    "tip_rms": ("tip RMS", "cm"), "tip_h1": ("tip at f", "cm"),
+    "strain1_rms": ("strain1 RMS", "strain"), "accel3_rms": ("accel3 RMS", "cm/s²"),
+    "impacts_per_s": ("impacts per s", ""), "switches_per_s": ("switches per s", ""),
+    "stick_share": ("stick share", ""), "share_0": ("free-flight share", ""),
+    "force_n_used": ("drive force used", "N"),
 }
 #: Resolution (Hz) of the spectrum the subharmonic's level is read from.
 SUB_RESOLUTION_HZ = 0.5
