@@ -37,6 +37,13 @@ def test_an_unknown_option_gets_the_nearest_and_one_prefix(capsys):
     assert "did you mean --gap-mm?" in err and err.count("workbench:") == 1
     assert cli.main(["run", "--gap-mm", "x"]) == 2
     assert capsys.readouterr().err.startswith("workbench: error: run: argument --gap-mm")
+    # the command's own options only: frf's --response is not offered to run
+    assert cli.main(["run", "--response", "accel9"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("workbench: error: run: unrecognized arguments: --response accel9")
+    assert "did you mean" not in err
+    assert cli.main(["frf", "x.uff", "--f-maxx", "3"]) == 2
+    assert "frf: unrecognized arguments: --f-maxx 3 (did you mean --f-max" in capsys.readouterr().err
 
 
 def test_compare_takes_the_model_options_over_the_records_settings(tmp_path, capsys):

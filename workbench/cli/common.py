@@ -61,10 +61,21 @@ class Parser(argparse.ArgumentParser):
         command = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
         if message.startswith("unrecognized arguments:"):
             near = [m for word in message.split(":", 1)[1].split() if word.startswith("--")
-                    for m in difflib.get_close_matches(word.split("=")[0], self.options(), 2, 0.6)]
+                    for m in difflib.get_close_matches(word.split("=")[0], self.options(), 2, 0.7)]
             if near:
                 message += f" (did you mean {' or '.join(dict.fromkeys(near))}?)"
         raise ParameterError(f"{command}{message}")
+
+    def parse_args(self, args=None, namespace=None):
+        """argparse's, but an unknown option is reported by the sub-command given, so that
+        the options it suggests are that command's."""
+        known, extras = self.parse_known_args(args, namespace)
+        if extras:
+            subs = [a for a in self._actions if isinstance(a, argparse._SubParsersAction)]
+            command = getattr(known, subs[0].dest, None) if subs else None
+            owner = subs[0].choices.get(command, self) if subs else self
+            owner.error(f"unrecognized arguments: {' '.join(extras)}")
+        return known
 
     def options(self) -> list[str]:
         """Every option string of this parser and its sub-commands."""
