@@ -188,12 +188,14 @@ def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
 
     ydot[N_DOF:N_STATE] holds M^-1 (Q - h) on entry (M's factor current)
     and q'' of the regime of ``rg`` on return; lambda (dyn) into rg, the
-    friction and constraint powers into ydot[A_FRIC], ydot[A_CONSTR].
+    friction and constraint powers into ydot[A_FRIC], ydot[A_CONSTR], and each
+    point's friction power into ydot[A_FRIC_P + k].
     """
     qd = y[ly.N_DOF:ly.N_STATE]
     qdd = ydot[ly.N_DOF:ly.N_STATE]
     for k in range(ly.N_POINTS):
         rg[ly.RG_LN + k] = 0.0
+        ydot[ly.A_FRIC_P + k] = 0.0
     rg[ly.RG_LT] = 0.0
     p_constr = 0.0
     p_fric = 0.0
@@ -227,8 +229,9 @@ def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
             # friction force -mu_k sigma lambda_n,k W_t,k: dissipates mu_k sigma lambda_n,k tau_k'
             for which in range(n_normal):
                 p = p1 if which == 0 else p2
-                p_fric += (P[ly.P_MU_K] * sign * rg[ly.RG_LN + p]
-                           * row_rate(cg, ly.CG_T + p, qd))
+                power = P[ly.P_MU_K] * sign * rg[ly.RG_LN + p] * row_rate(cg, ly.CG_T + p, qd)
+                ydot[ly.A_FRIC_P + p] = power
+                p_fric += power
     ydot[ly.A_FRIC] = p_fric
     ydot[ly.A_CONSTR] = p_constr
 

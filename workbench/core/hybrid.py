@@ -49,7 +49,7 @@ from .integrate import rk_step
 from .event_functions import event_values
 from .pair import dense
 from .sensors import fill_signals
-from .transitions import choose_regime, impact, moreau_jean_step
+from .transitions import book_losses, choose_regime, impact, moreau_jean_step
 
 
 @nb.njit(**JIT_INLINE)
@@ -474,8 +474,9 @@ def apply_event(e, t, model, ex, work, log, n_log, st):
             q = int(cw[ly.CW_PTS, i])
             row[ly.LOG_P + q] = cw[ly.CW_P, 2 * i]
             row[ly.LOG_PT] += cw[ly.CW_P, 2 * i + 1]
+            row[ly.LOG_DKE_P + q] = cw[ly.CW_LOSS, i]
         row[ly.LOG_DKE] = lost
-        st[ly.ST_E_IMPACT] += lost
+        book_losses(st, cw, n_pts, lost)
         st[ly.ST_N_IMPACTS] += 1.0
         st[ly.ST_T_IMPACT] = t
         if accumulating:

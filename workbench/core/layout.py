@@ -196,7 +196,8 @@ A_DAMP = N_STATE + 1    # dissipated by structural damping, int q'^T C q' dt
 A_CORK = N_STATE + 2    # dissipated by the cork damper, int c s'^2 dt
 A_FRIC = N_STATE + 3    # dissipated by Coulomb friction while slipping
 A_CONSTR = N_STATE + 4  # work of the normal and sticking contact forces (ideally 0)
-N_AUG = N_STATE + 5
+A_FRIC_P = N_STATE + 5  # A_FRIC_P + k: the part of A_FRIC dissipated at point k + 1
+N_AUG = A_FRIC_P + 4
 
 # --- contact (docs/model.md §7) ---------------------------------------------------
 N_POINTS = 4
@@ -247,9 +248,10 @@ CW_P = CW_U + 1              # impulses P (dyn s)
 CW_MODES = CW_P + 1          # per point: impact_law.OPEN, STICK, SLIP_POS, SLIP_NEG
 CW_MU = CW_MODES + 1         # per point: mu
 CW_PTS = CW_MU + 1           # the impact set's points (0-based), -1 for none
+CW_LOSS = CW_PTS + 1         # per point of the set: kinetic energy its impulses removed (erg)
 N_LAW = 23                   # scratch rows of the impact law
 N_LAW_COLS = 18              # its columns: Lemke's tableau of 8 unknowns
-CW_LAW = CW_PTS + 1
+CW_LAW = CW_LOSS + 1
 N_CW = CW_LAW + N_LAW
 N_CW_COLS = N_LAW_COLS
 
@@ -281,7 +283,8 @@ LOG_POINT = 4    # the point whose event it was (1..4), 0 for none
 LOG_P = 5        # LOG_P + k: normal impulse of point k + 1 (dyn s)
 LOG_PT = LOG_P + N_POINTS    # tangential impulse (dyn s)
 LOG_DKE = LOG_PT + 1         # kinetic energy lost (erg)
-N_LOG = LOG_DKE + 1
+LOG_DKE_P = LOG_DKE + 1      # LOG_DKE_P + k: the part lost at point k + 1 (erg)
+N_LOG = LOG_DKE_P + N_POINTS
 
 # Run statistics st (N_ST,)
 ST_MAX_PEN = 0       # largest penetration -g of an open gap at an accepted state (cm)
@@ -307,7 +310,8 @@ ST_PEN_WHERE = 19    # where it was found: 10 x (1 event bracket, 2 step end) + 
 ST_FLOOD_T0 = 20     # start of the window in which events are counted for a flood (s)
 ST_FLOOD_N = 21      # events in that window
 ST_STEPPED_UNTIL = 22    # Moreau-Jean time-stepping runs until this time (s) after a flood
-N_ST = 23
+ST_E_IMPACT_P = 23   # ST_E_IMPACT_P + k: the part of ST_E_IMPACT lost at point k + 1 (erg)
+N_ST = ST_E_IMPACT_P + 4
 
 # --- the error-controlled integration (workbench.core.adaptive) ----------------
 # Controller record ctl (N_CTL,): its state between calls and its statistics.
@@ -351,9 +355,11 @@ SIGNALS = ("force1", "hammer", "strain1", "strain2", "accel1", "accel2", "accel3
            "gap1", "gap2", "gap3", "gap4", "lambda_n1", "lambda_n2", "lambda_n3", "lambda_n4",
            "lambda_t", "regime",
            "e_kin", "e_elastic", "e_gravity", "e_cork",
-           "w_excitation", "d_structural", "d_cork", "d_friction", "d_impact", "w_constraint")
+           "w_excitation", "d_structural", "d_cork", "d_friction", "d_impact", "w_constraint",
+           "d_friction1", "d_friction2", "d_friction3", "d_friction4",
+           "d_impact1", "d_impact2", "d_impact3", "d_impact4")
 SIGNAL_UNITS = ("dyn", "dyn", "-", "-", "cm/s^2", "cm/s^2", "cm/s^2", "cm",
-                "cm", "cm", "cm", "cm", "dyn", "dyn", "dyn", "dyn", "dyn", "-") + ("erg",) * 10
+                "cm", "cm", "cm", "cm", "dyn", "dyn", "dyn", "dyn", "dyn", "-") + ("erg",) * 18
 SIG_FORCE1 = SIGNALS.index("force1")
 SIG_HAMMER = SIGNALS.index("hammer")
 SIG_STRAIN1 = SIGNALS.index("strain1")
@@ -376,4 +382,6 @@ SIG_D_CORK = SIGNALS.index("d_cork")
 SIG_D_FRIC = SIGNALS.index("d_friction")
 SIG_D_IMPACT = SIGNALS.index("d_impact")
 SIG_W_CONSTR = SIGNALS.index("w_constraint")
+SIG_D_FRIC_P = SIGNALS.index("d_friction1")      # + k: point k + 1's part of d_friction
+SIG_D_IMPACT_P = SIGNALS.index("d_impact1")      # + k: point k + 1's part of d_impact
 N_SIG = len(SIGNALS)

@@ -85,3 +85,6 @@ def fill_signals(y, ydot, P, tab, kc, rec, mat, vec, cg, rg, st, out):
     out[ly.SIG_D_FRIC] = y[ly.A_FRIC]
     out[ly.SIG_D_IMPACT] = st[ly.ST_E_IMPACT]
     out[ly.SIG_W_CONSTR] = y[ly.A_CONSTR]
+    for k in range(ly.N_POINTS):
+        out[ly.SIG_D_FRIC_P + k] = y[ly.A_FRIC_P + k]
+        out[ly.SIG_D_IMPACT_P + k] = st[ly.ST_E_IMPACT_P + k]

@@ -95,7 +95,10 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
 
     M and its factor must be current at y.  Updates q' in y and the regime
     in rg (read from the solution, not yet chosen at acceleration level);
-    leaves P in cw[CW_P] for the points in cw[CW_PTS].
+    leaves P in cw[CW_P] for the points in cw[CW_PTS] and the kinetic energy
+    each point's impulses removed in cw[CW_LOSS] (they sum to the total:
+    T- - T+ = -sum_r P_r (u-_r + u+_r) / 2 over the rows, normal and
+    tangential, of the points).
 
     ``close_within`` > 0 (s) closes an accumulation (docs/model.md §7): a point
     of the set that leaves the impact slower than its free gap acceleration
@@ -134,6 +137,12 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
     if close_within > 0.0:
         _close_accumulation(y, P, cg, cw, pts, m, modes, a0, close_within)
     ke_plus = kinetic_energy(qd, mat)
+    for i in range(m):
+        p = int(pts[i])
+        un = row_rate(cg, ly.CG_G + p, qd)
+        ut = row_rate(cg, ly.CG_T + p, qd)
+        cw[ly.CW_LOSS, i] = -(imp[2 * i] * (u[2 * i] + un)
+                              + imp[2 * i + 1] * (u[2 * i + 1] + ut)) / 2.0
     # the new regime: the points that did not open
     first = -1
     second = -1
@@ -162,6 +171,15 @@ def impact(y, point, P, free, mat, cg, cw, rg, gap_tol, a0, close_within, lookah
         if abs(rate) > REST_RATE:
             rg[ly.RG_SIGN] = 1.0 if rate > 0.0 else -1.0
     return ly.OK, m, ke_minus - ke_plus
+
+
+@nb.njit(**JIT)
+def book_losses(st, cw, n_pts, lost):
+    """Add an impact's kinetic energy lost (erg; :func:`impact`) to the run's statistics: the
+    total to st[ST_E_IMPACT], each point's part to st[ST_E_IMPACT_P + k]."""
+    st[ly.ST_E_IMPACT] += lost
+    for i in range(n_pts):
+        st[ly.ST_E_IMPACT_P + int(cw[ly.CW_PTS, i])] += cw[ly.CW_LOSS, i]
 
 
 @nb.njit(**JIT)
@@ -387,7 +405,7 @@ def choose_regime(t, y, model, ex, work, ydot, st, gap_tol):
             return status
         st[ly.ST_N_INCONSISTENT] += 1.0
         st[ly.ST_E_INCONSISTENT] += lost
-        st[ly.ST_E_IMPACT] += lost
+        book_losses(st, cw, n_pts, lost)
     project(y, P, free, cg, cw, rg, np.bool_(True))
     arm_gaps(y, P, cg, rg)
     return rhs_regime(t, y, model, ex, work, ydot)
@@ -448,7 +466,7 @@ def moreau_jean_step(t, h, model, ex, work, st):
     if status != ly.OK:
         return status
     st[ly.ST_E_STEPPED] += lost
-    st[ly.ST_E_IMPACT] += lost
+    book_losses(st, cw, n_pts, lost)
     st[ly.ST_N_STEPPED] += 1.0
     for i in range(ly.N_DOF):
         y[i] = ym[i] + 0.5 * h * ym[ly.N_DOF + i]

@@ -116,7 +116,8 @@ class Run:
 
     @functools.cached_property
     def events(self) -> pd.DataFrame:
-        """DataFrame of the event log: time, kind, from/to regime, point, impulses, energy lost."""
+        """DataFrame of the event log: time, kind, from/to regime, point, impulses, kinetic
+        energy lost (erg) and each point's part of it."""
         import pandas as pd
         logs = self.log
         return pd.DataFrame({
@@ -129,6 +130,7 @@ class Run:
             **{f"impulse_n{k + 1}": logs[:, ly.LOG_P + k] for k in range(ly.N_POINTS)},
             "impulse_t": logs[:, ly.LOG_PT],
             "ke_lost": logs[:, ly.LOG_DKE],
+            **{f"ke_lost{k + 1}": logs[:, ly.LOG_DKE_P + k] for k in range(ly.N_POINTS)},
         })
 
     @property
