@@ -41,10 +41,10 @@ bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmark
 		--targets README.md
 
 # The studies of `make study` (studies/<name>.toml -> results/<name>/report.md).
-STUDIES := free_decay stepped chirp shaker
+STUDIES := free_decay stepped chirp shaker damage
 SOURCES := $(shell find workbench -name "*.py" -not -path "*/__pycache__/*")
 
-study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, modes, identification, estimator)
+study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, damage map, modes, identification, estimator)
 
 $(RESULTS)/index.md: $(foreach s,$(STUDIES),$(RESULTS)/$(s)/report.md) $(RESULTS)/modes/modes.md \
 		$(RESULTS)/identification/identification.md $(RESULTS)/estimate/estimate.md \

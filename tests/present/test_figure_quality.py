@@ -130,6 +130,24 @@ gap_mm = [1.016]
 """
 
 
+DAMAGE = """
+[study]
+name = "damage"
+duration_s = 1.2
+window_s = 0.5
+
+[excitation]
+drive = "sine"
+ramp_s = 0.3
+
+[axes]
+gap_mm = [0.508, 1.016]
+freq_hz = [15.0, 30.0, 45.0]
+force_n = [20.0, 100.0]
+tip_mass = [false, true]
+"""
+
+
 def _report(tmp_path, text, name):
     path = tmp_path / f"{name}.toml"
     path.write_text(text)
@@ -138,12 +156,14 @@ def _report(tmp_path, text, name):
     make_report(study, tmp_path / "res", jobs=1)
 
 
-def test_the_figures_of_a_grid_and_a_chirp_report_are_clean(tmp_path, checked):
+def test_the_figures_of_a_grid_a_chirp_and_a_damage_report_are_clean(tmp_path, checked):
     _report(tmp_path, GRID, "grid")
     _report(tmp_path, CHIRP, "chirp")
+    _report(tmp_path, DAMAGE, "damage")
     names = [n for n, _ in checked]
     for expected in ("frf_map_tip", "response_curves", "regime_shares", "bifurcation",
-                     "time_history_", "strain_spectra_", "switching_", "spectrogram_", "frf_"):
+                     "time_history_", "strain_spectra_", "switching_", "spectrogram_", "frf_",
+                     "wear_map", "impact_map", "friction_map"):
         assert any(n.startswith(expected) for n in names), (expected, names)
     bad = [(n, p) for n, p in checked if p]
     assert not bad, "\n".join(f"{n}: {p}" for n, p in bad)

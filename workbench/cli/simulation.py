@@ -135,7 +135,10 @@ def _cmd_run(args) -> int:
         else:
             files.write(args.out, files.record_from_run(run), meta)
     from ..model.validity import exceeded_words
+    from ..study.wear import run_wear
     summary = run.summary()
+    if run.ok:
+        summary["wear"] = run_wear(run, drive.get("ramp_s", 0.0), drive.get("freq_hz"))
     if summary["out_of_range"]:
         print(f"workbench: warning: the run left the range the model is validated for "
               f"({exceeded_words(summary, p)})", file=sys.stderr)
@@ -184,6 +187,12 @@ def human_summary(summary: dict, out=None) -> str:
                 value = value * factor
             text = _plain(value) if value not in ("", None) else "-"
             lines.append(f"{name:>20}: {text}{' ' + unit if unit and text != '-' else ''}")
+    wear = summary.get("wear")
+    if wear:
+        lines.append(f"{'wear per ' + wear['per']:>20}: "
+                     f"{_plain(wear['wear_volume_cm3'] * SI['cm³'][1])} mm³ (Archard), friction "
+                     f"{_plain(wear['friction_work_erg'] * SI['erg'][1])} mJ, impacts "
+                     f"{_plain(wear['impact_energy_erg'] * SI['erg'][1])} mJ")
     if out:
         lines.append(f"{'wrote':>20}: {out}")
     return "\n".join(lines)

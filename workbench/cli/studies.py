@@ -1,12 +1,14 @@
-"""``workbench sweep`` and ``report``: a study's grid, in parallel and resumably
-(on joblib or a Dask cluster), and its figures, tables and report."""
+"""``workbench sweep``, ``report`` and ``advise``: a study's grid, in parallel and resumably
+(on joblib or a Dask cluster), its figures, tables and report, and the advice a damage map
+gives (study/advice.py)."""
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..model.params import ParameterError
 from ..study.paths import check_output_dir
-from .common import (EXIT_OK, EXIT_POINTS_FAILED, RESULTS, add_jobs_option, json_text)
+from .common import (EXIT_OK, EXIT_POINTS_FAILED, RESULTS, add_jobs_option, json_text, number,
+                     on_off)
 
 
 def _cmd_sweep(args) -> int:
@@ -65,6 +67,36 @@ def _cmd_report(args) -> int:
     return EXIT_OK
 
 
+def _cmd_advise(args) -> int:
+    from ..study.advice import ADVICE_MEASURES, advise
+
+    advice = advise(args.results, args.gap_mm, args.freq_hz, args.force_n, args.tip_mass,
+                    args.allow_level)
+    if args.json:
+        print(json_text(advice.to_dict()))
+        return EXIT_OK
+    units = {name: unit for name, _, unit in ADVICE_MEASURES.values()}
+
+    def measures(values: dict) -> str:
+        return ", ".join(f"{k} {values[k]:.3g} {units[k]}" for k in units)
+
+    where = f"{args.gap_mm:g} mm, {args.freq_hz:g} Hz, {args.force_n:g} N"
+    lines = [f"here ({where}): {measures(advice.here)}",
+             f"regime to avoid (wear volume >= {advice.threshold_mm3:.3g} mm³/cycle): "
+             f"{'yes' if advice.avoid else 'no'}"]
+    if advice.frequency_change:
+        c = advice.frequency_change
+        lines.append(f"move the frequency by {c['change_hz']:+g} Hz to {c['freq_hz']:g} Hz: "
+                     f"{measures(c)}")
+    if advice.level_change:
+        c = advice.level_change
+        lines.append(f"or lower the level by {-c['change_n']:g} N to {c['force_n']:g} N: "
+                     f"{measures(c)}")
+    lines += [f"note: {n}" for n in advice.notes]
+    print("\n".join(lines))
+    return EXIT_OK
+
+
 def add_parsers(sub) -> None:
     """Add this module's sub-commands to the parser's ``sub``."""
     sweep = sub.add_parser("sweep", help="run a study's grid (TOML) in parallel, resumably")
@@ -86,3 +118,19 @@ def add_parsers(sub) -> None:
     report.add_argument("--results", default=str(RESULTS), help="results root (default results/)")
     add_jobs_option(report, "processes drawing the figures")
     report.set_defaults(func=_cmd_report)
+
+    adv = sub.add_parser("advise", help="a damage map's advice at a gap, frequency and level: the "
+                         "wear here, whether to avoid it, the nearest way out")
+    adv.add_argument("--gap-mm", type=number(0, lo_open=True), required=True, help="the gap (mm)")
+    adv.add_argument("--freq-hz", type=number(0, lo_open=True), required=True,
+                     help="the drive frequency (Hz)")
+    adv.add_argument("--force-n", type=number(0, lo_open=True), required=True,
+                     help="the drive's force amplitude (N)")
+    adv.add_argument("--tip-mass", type=on_off, default=None,
+                     help="on or off (needed when the map has both)")
+    adv.add_argument("--allow-level", action="store_true",
+                     help="also look for a lower level that leaves the regime to avoid")
+    adv.add_argument("--results", default=str(RESULTS / "damage"),
+                     help="the damage map's folder (default results/damage)")
+    adv.add_argument("--json", action="store_true", help="one JSON object")
+    adv.set_defaults(func=_cmd_advise)

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import math
 
-#: The beam bar, 2 in x 1/8 in (cm): width b and height h of Eq. 1.
-BAR_WIDTH_CM = 5.08
+from ..model.params import BAR_WIDTH_CM  # noqa: F401  (b of Eq. 1, kept with the model)
+
+#: The beam bar, 2 in x 1/8 in (cm): height h of Eq. 1 (its width b is BAR_WIDTH_CM).
 BAR_HEIGHT_CM = 0.3175
 
 #: Table 3 (§4.1): density (g/cm^3), rigid masses (g), mass per length (g/cm).

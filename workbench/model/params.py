@@ -50,6 +50,9 @@ CORK_MODELS: dict[str, CorkLaw] = {
 
 #: The paper's gaps (mm), seed §5.1.
 PAPER_GAPS_MM = (0.508, 0.635, 0.762, 1.016)
+#: The beam bar's width, 2 in (cm; §4.1): out of the model's plane, the length of a contact
+#: line across the bar, and b of the sections' b h^3 / 12 (identify.paper).
+BAR_WIDTH_CM = 5.08
 
 #: Unit suffixes accepted at the user boundary: suffix -> (CGS unit it
 #: converts to, factor to multiply by).

@@ -17,12 +17,14 @@ in ``tables/frf_modes.{csv,md,tex}``.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from pathlib import Path
 
 import pandas as pd
 
+from . import damage as D
 from . import figures as F
 from ..study.grid import point_slug, point_title
 from ..study.provenance import environment
@@ -55,6 +57,10 @@ def _grid_figures(study: Study, table: pd.DataFrame) -> dict[str, object]:
     if sine:
         figs["regime_shares"] = lambda: F.regime_shares(table)
         figs["bifurcation"] = lambda: F.bifurcation(table)
+    if D.is_wear_map(table):
+        for name, measure in (("wear_map", "wear_volume_cm3"), ("impact_map", "impact_energy_erg"),
+                              ("friction_map", "friction_work_erg")):
+            figs[name] = (lambda m: lambda: D.wear_map(table, m, study.wear))(measure)
     return figs
 
 
@@ -160,6 +166,8 @@ def make_report(study: Study, results: str | Path = "results", jobs: int = 1) ->
     tables = write_tables(table, out / "tables")
     if frf_modes:
         tables += write_frf_modes(pd.concat(frf_modes, ignore_index=True), out / "tables")
+    if D.is_wear_map(table):
+        tables += D.write_extremes(table, study.wear, out / "tables")
     report_wall = time.perf_counter() - t0
     provenance = {**environment(), "study": study_definition(study),
                   "points": summary(table), "report_wall_s": report_wall,
@@ -177,6 +185,7 @@ def study_definition(study: Study) -> dict:
             "dt": study.dt, "output_hz": study.output_hz, "method": study.method,
             "tol": study.tol, "initial": study.initial,
             "excitation": study.excitation, "fixed": study.fixed, "axes": study.axes,
+            "wear": dataclasses.asdict(study.wear),
             "parameters_of_first_point": study.points[0].params.to_dict() if study.points else {}}
 
 
@@ -208,6 +217,8 @@ def render_index(study, table, figures, tables, out) -> str:
     lines += accuracy_lines(study, table)
     lines += level_lines(study, table)
     lines += range_lines(table)
+    if D.is_wear_map(table):
+        lines += D.damage_lines(table, study.wear)
     if tables:
         lines += ["## Tables", "", "Values in SI (N, m/s², µε, mm), each column's unit in its "
                   "header; the points table keeps the model's CGS.", ""]

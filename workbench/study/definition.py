@@ -31,6 +31,10 @@
     resolution = 1.25                # the force found within this factor of the largest
     max_runs = 10                    # runs a point may take
 
+    [wear]                           # optional: Archard's constants of the wear volume
+    k_archard = 1e-4                 # (study/wear.py: unit, range, source of each)
+    hardness_pa = 1e9
+
     [fixed]                          # any model parameter (workbench params), unit suffixes allowed
     mu_s = 0.3
 
@@ -70,6 +74,7 @@ import numpy as np
 from ..model import drives
 from . import sensitivity
 from .leveling import Limits
+from .wear import WearConstants, wear_constants
 from ..model.limits import MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
@@ -129,6 +134,7 @@ class Study:
     method: str = "dop853"
     tol: float | None = None
     limits: Limits | None = None
+    wear: WearConstants = WearConstants()
     check_accuracy: bool = False
     sample: sensitivity.Sample | None = None
     points: tuple = field(default=(), repr=False)
@@ -177,11 +183,11 @@ def load(path: str | Path) -> Study:
 
 def from_dict(data: dict[str, Any], source: str = "") -> Study:
     """A Study from the parsed TOML tables (see the module docstring)."""
-    tables = ("study", "excitation", "limits", "fixed", "axes", "sample", "ranges")
+    tables = ("study", "excitation", "limits", "wear", "fixed", "axes", "sample", "ranges")
     unknown = sorted(set(data) - set(tables))
     if unknown:
         raise StudyError(f"unknown table(s) {unknown}: use [study], [excitation], [limits], "
-                         "[fixed], [axes], or [sample] with [ranges]")
+                         "[wear], [fixed], [axes], or [sample] with [ranges]")
     for table in tables:
         if table in data and not isinstance(data[table], dict):
             raise StudyError(f"[{table}] must be a table of keys, got {_short(data[table])}")
@@ -208,6 +214,10 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     inputs = {} if sample is None else {k: None for k in [*sample.names, *sample.same]}
     _check_keys(drive, exc, fixed, axes, inputs)
     limits = _limits(data["limits"]) if "limits" in data else None
+    try:
+        wear = wear_constants(data.get("wear"))
+    except ParameterError as exc:
+        raise StudyError(str(exc)) from None
     if limits is not None and "force_n" not in drives.DRIVES[drive].keys:
         raise StudyError(f"[limits] sets each point's force: a {drive!r} excitation has no "
                          "force_n")
@@ -226,7 +236,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     series = _save_series(head.get("save_series", []), set(axes) | set(drives.DRIVES[drive].keys))
     return Study(**run, excitation={"drive": drive, **exc}, fixed=fixed, axes=axes,
                  save_series=series, source=source, points=tuple(points), limits=limits,
-                 sample=sample)
+                 wear=wear, sample=sample)
 
 
 def _run_settings(head: dict) -> dict:

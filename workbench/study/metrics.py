@@ -44,6 +44,7 @@ import numpy as np
 
 from ..model import regimes
 from ..model.regimes import contact_shares_of, regime_time_of
+from .wear import WearConstants, wear_measures
 from ..model.validity import validity
 from ..model.run_result import CONTACT_STAT_KEYS
 
@@ -177,8 +178,9 @@ def contact_shares(events, t0: float, t1: float) -> dict[str, float]:
 
 
 def point_metrics(run, window_s: float, drive_hz: float | None = None,
-                  steady_tol: float = STEADY_TOL) -> dict:
-    """The metrics of the module docstring for a finished :class:`~workbench.model.run_result.Run`."""
+                  wear: WearConstants = WearConstants(), steady_tol: float = STEADY_TOL) -> dict:
+    """The metrics of the module docstring for a finished :class:`~workbench.model.run_result.Run`,
+    the wear measures (:mod:`workbench.study.wear`, with Archard's constants ``wear``) among them."""
     sig = run.signals
     t = sig.index.to_numpy()
     t_end = float(t[-1])
@@ -222,6 +224,7 @@ def point_metrics(run, window_s: float, drive_hz: float | None = None,
     for name, col in DISSIPATION.items():
         x = sig[col].to_numpy()
         out[f"diss_{name}"] = float((x[-1] - x[win][0]) / cycles)
+    out.update(wear_measures(run, t0, t_end, cycles, wear))
     out.update(validity(run))
     return out
 

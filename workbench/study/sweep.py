@@ -68,7 +68,7 @@ def point_key(study: Study, point: Point, previous_key: str = "") -> str:
         "window_s": study.window_s, "dt": study.dt, "output_hz": study.output_hz,
         "method": study.method, "tol": study.tol, "initial": study.initial, "previous": previous_key, "code": code_version(),
         "limits": study.limits.to_dict() if study.limits else None,
-        "check_accuracy": study.check_accuracy,
+        "wear": study.wear.key(), "check_accuracy": study.check_accuracy,
     }
     text = json.dumps(record, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -132,7 +132,7 @@ def run_point(study: Study, point: Point, key: str, out: Path, initial=None,
             run, levelled = found.run, found.row()
             if study.check_accuracy and run.ok:      # the same run again, with its companion
                 run = simulate_at(found.force_n, check_accuracy=True)
-        metrics = ({**levelled, **point_metrics(run, study.window_s, point.drive_hz)}
+        metrics = ({**levelled, **point_metrics(run, study.window_s, point.drive_hz, study.wear)}
                    if run.ok else levelled)
         row = _row(point, key, "ok" if run.ok else "failed", run.message,
                    time.perf_counter() - t0, metrics, run, continued)
