@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-sys.path.insert(0, str(Path(__file__).parent))   # tests/fe_reference.py
+sys.path.insert(0, str(Path(__file__).parent))   # tests/fe_reference.py, small_studies.py
 
 from workbench.model.params import Parameters  # noqa: E402
 
@@ -33,8 +33,8 @@ def random_state(rng):
 #: (``--dist loadscope --no-loadscope-reorder``); these go first, so that no long module
 #: starts when the other worker is nearly done.
 LONG_MODULES = ("test_docs.py", "reference/test_reference_events.py", "study/test_sweep.py",
-                "study/test_sensitivity.py", "lab/test_compare_estimate.py",
-                "lab/test_frf.py")
+                "present/test_figure_quality.py", "study/test_sensitivity.py",
+                "study/test_wear.py", "lab/test_compare_estimate.py", "lab/test_frf.py")
 
 
 def pytest_collection_modifyitems(session, config, items):

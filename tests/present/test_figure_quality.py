@@ -16,6 +16,8 @@ from workbench.study import definition as S
 from workbench.study import sweep as W
 from workbench.present.report import make_report
 
+from small_studies import CHIRP, DAMAGE, SMALL
+
 #: Two texts overlap when their boxes share more than this many square pixels (at the saved DPI).
 OVERLAP_PX2 = 4.0
 
@@ -94,58 +96,14 @@ def checked(monkeypatch):
     return seen
 
 
-GRID = """
-[study]
-name = "grid"
-duration_s = 0.5
-window_s = 0.2
-save_series = [{gap_mm = 1.016, freq_hz = 20.0}]
-
-[excitation]
-drive = "sine"
-force_n = 20.0
-ramp_s = 0.1
-
-[axes]
-gap_mm = [0.508, 0.762, 1.016]
-freq_hz = [10.0, 20.0, 30.0, 40.0, 50.0]
-tip_mass = [false, true]
-"""
-
-CHIRP = """
-[study]
-name = "chirp"
-duration_s = 2.0
-window_s = 1.0
-save_series = [{gap_mm = 1.016}]
-
-[excitation]
-drive = "chirp"
-f0_hz = 5.0
-f1_hz = 65.0
-sweep_s = 2.0
-
-[axes]
-gap_mm = [1.016]
-"""
+#: The sweep tests' small grid with a third gap, five frequencies and the tip mass on and off.
+GRID = SMALL.replace('name = "small"', 'name = "grid"').replace(
+    "gap_mm = [0.508, 1.016]\nfreq_hz = [20.0, 30.0]",
+    "gap_mm = [0.508, 0.762, 1.016]\nfreq_hz = [10.0, 20.0, 30.0, 40.0, 50.0]\n"
+    "tip_mass = [false, true]")
 
 
-DAMAGE = """
-[study]
-name = "damage"
-duration_s = 1.2
-window_s = 0.5
 
-[excitation]
-drive = "sine"
-ramp_s = 0.3
-
-[axes]
-gap_mm = [0.508, 1.016]
-freq_hz = [15.0, 30.0, 45.0]
-force_n = [20.0, 100.0]
-tip_mass = [false, true]
-"""
 
 
 def _report(tmp_path, text, name):
@@ -159,7 +117,7 @@ def _report(tmp_path, text, name):
 def test_the_figures_of_a_grid_a_chirp_and_a_damage_report_are_clean(tmp_path, checked):
     _report(tmp_path, GRID, "grid")
     _report(tmp_path, CHIRP, "chirp")
-    _report(tmp_path, DAMAGE, "damage")
+    _report(tmp_path, DAMAGE.replace("[axes]", "[axes]\ntip_mass = [false, true]"), "damage")
     names = [n for n, _ in checked]
     for expected in ("frf_map_tip", "response_curves", "regime_shares", "bifurcation",
                      "time_history_", "strain_spectra_", "switching_", "spectrogram_", "frf_",

@@ -16,22 +16,8 @@ from workbench.present.report import make_report, series_tags
 from workbench.model.params import ParameterError
 from workbench.study.store import read_runs
 
-SMALL = """
-[study]
-name = "small"
-duration_s = 0.5
-window_s = 0.2
-save_series = [{gap_mm = 1.016, freq_hz = 20.0}]
+from small_studies import CHIRP, SMALL
 
-[excitation]
-drive = "sine"
-force_n = 20.0
-ramp_s = 0.1
-
-[axes]
-gap_mm = [0.508, 1.016]
-freq_hz = [20.0, 30.0]
-"""
 
 
 def write(tmp_path, text, name="study.toml"):
@@ -291,22 +277,7 @@ def test_report_drawn_by_two_processes_is_the_serial_one(small_run, tmp_path):
 
 
 def test_report_of_a_chirp_has_a_spectrogram_and_its_frfs(tmp_path):
-    text = """
-[study]
-name = "chirp"
-duration_s = 1.0
-window_s = 0.5
-save_series = [{gap_mm = 1.016}]
-
-[excitation]
-drive = "chirp"
-f0_hz = 5.0
-f1_hz = 65.0
-sweep_s = 1.0
-
-[axes]
-gap_mm = [1.016]
-"""
+    text = CHIRP
     study = S.load(write(tmp_path, text))
     table = W.run_study(study, tmp_path / "res", jobs=1, progress=False)
     assert table.status.tolist() == ["ok"] and "tip_poincare" not in table

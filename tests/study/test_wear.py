@@ -21,6 +21,8 @@ from workbench.study.advice import advise
 from workbench.study.metrics import point_metrics
 from workbench.study.wear import WearConstants, wear_constants, wear_measures
 
+from small_studies import DAMAGE
+
 
 def test_the_points_friction_work_adds_up_to_the_audits_over_the_window():
     """100 N at 20 Hz, the steady window the last second: the friction work of the four points
@@ -93,24 +95,6 @@ def test_the_wear_constants_are_checked():
         wear_constants({"hardness": 1e9})
 
 
-DAMAGE = """
-[study]
-name = "damage"
-duration_s = 1.2
-window_s = 0.5
-
-[excitation]
-drive = "sine"
-ramp_s = 0.3
-
-[wear]
-threshold_mm3 = 1e-7
-
-[axes]
-gap_mm = [0.508, 1.016]
-freq_hz = [15.0, 30.0, 45.0]
-force_n = [20.0, 100.0]
-"""
 
 
 @pytest.fixture(scope="module")
