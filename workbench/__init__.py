@@ -9,10 +9,11 @@ The API a user calls (docs/usage.md)::
     run.summary()
 
 - the model: :class:`Parameters`, :func:`simulate` (a :class:`Run`),
-  :func:`static_equilibrium`, :func:`natural_frequencies`, :func:`mode_shapes`;
+  :func:`static_equilibrium`, :func:`natural_frequencies`, :func:`mode_shapes`,
+  :func:`periodic_orbit`;
 - the drives: :func:`sine`, :func:`chirp`, :func:`hammer_joint`,
   :func:`hammer_tip` (module :mod:`drives`, the registry of drives);
-- studies: :func:`load_study`, :func:`sweep`;
+- studies: :func:`load_study`, :func:`sweep`, :func:`wear_measures`, :func:`advise`;
 - lab files: :func:`read`, :func:`write`, :func:`convert`,
   :func:`record_from_run`, :func:`frf`, :func:`compare`.
 
@@ -42,6 +43,8 @@ _API = {
     "convert": ("lab.files", "convert"),
     "record_from_run": ("lab.files", "record_from_run"),
     "frf": ("lab.frf", "frf"), "compare": ("present.comparison", "compare"),
+    "periodic_orbit": ("model.orbit", "periodic_orbit"),
+    "wear_measures": ("study.wear", "wear_measures"), "advise": ("study.advice", "advise"),
 }
 
 __all__ = ["CORK_MODELS", "ParameterError", "Parameters", "__version__", *_API]

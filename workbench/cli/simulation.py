@@ -9,13 +9,14 @@ import time
 
 import numpy as np
 
-from ..model.limits import DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_OUTPUT_HZ, MIN_DT
+from ..model.limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MAX_OUTPUT_HZ,
+                            MIN_DT)
 from ..model.params import ParameterError, describe
 from ..model.shown_units import SI
 from ..study.paths import check_output_file
-from .common import (EXIT_INTERNAL, EXIT_OK, EXIT_RUN_FAILED, add_drive_options, add_joint_options,
-                     add_model_options, json_text, number, parameters_of,
-                     shortcut_drive)
+from .common import (EXIT_INTERNAL, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_RUN_FAILED,
+                     add_drive_options, add_joint_options, add_model_options, json_text, number,
+                     parameters_of, shortcut_drive)
 
 
 def _cmd_modes(args) -> int:
@@ -198,6 +199,33 @@ def human_summary(summary: dict, out=None) -> str:
     return "\n".join(lines)
 
 
+def _cmd_orbit(args) -> int:
+    from ..model import drives
+    from ..model.orbit import periodic_orbit
+    from ..model.packing import JOINT
+    p = parameters_of(args)
+    orbit = periodic_orbit(p, drives.sine(args.force_n, args.freq_hz), periods=args.periods,
+                           fixed=JOINT if args.joint == "locked" else ())
+    found = orbit.to_dict()
+    if args.json:
+        print(json_text({key: value for key, value in found.items() if key != "state"}))
+    else:
+        mu = orbit.deciding()
+        print("\n".join([
+            f"{'status':>20}: {orbit.status} ({orbit.message})",
+            f"{'period':>20}: {orbit.period_s:.6g} s ({orbit.periods} drive period(s))",
+            f"{'residual':>20}: {orbit.residual:.3g} after {orbit.newton_iterations} Newton step(s)",
+            f"{'largest |multiplier|':>20}: "
+            + (f"{abs(mu[0]):.6g}" if len(mu) else "-")
+            + ("" if orbit.stable is None else (" (stable)" if orbit.stable else " (unstable)"))
+            + ("" if orbit.neutral is None else "; the stuck position's 1 left out"),
+            f"{'contact code':>20}: {found['contact_code']} at phase 0; events per period: "
+            + (", ".join(f"{k} {v:g}" for k, v in orbit.events_per_period.items() if v) or "none"),
+            f"{'tip amplitude':>20}: {_plain(orbit.tip_amplitude_cm * SI['cm'][1])} mm",
+            f"{'wall':>20}: {orbit.wall_s:.3g} s"]))
+    return EXIT_OK if orbit.status == "converged" else EXIT_NOT_CONVERGED
+
+
 def _cmd_params(args) -> int:
     p = parameters_of(args)
     rows = describe()
@@ -262,6 +290,21 @@ def add_parsers(sub) -> None:
                      ".parquet (every signal, and the events), .lvm, .txt, .tdms, .uff (Table 2)")
     run.add_argument("--json", action="store_true", help="print one JSON object")
     run.set_defaults(func=_cmd_run)
+
+    orbit = sub.add_parser("orbit", help="a periodic response of a sine drive by shooting, and "
+                           "its Floquet multipliers (model/orbit.py)")
+    add_model_options(orbit)
+    orbit.add_argument("--freq-hz", type=number(0, lo_open=True), required=True,
+                       help="the sine's frequency (Hz)")
+    orbit.add_argument("--force-n", type=number(0, MAX_FORCE_N, lo_open=True),
+                       default=drives.DEFAULT_FORCE_N,
+                       help=f"the sine's amplitude (N; default {drives.DEFAULT_FORCE_N:g})")
+    orbit.add_argument("--periods", type=number(1, 64, integer=True), default=1,
+                       help="drive periods of the orbit (default 1; 2 for a period doubling)")
+    orbit.add_argument("--joint", choices=("free", "locked"), default="free",
+                       help="free (default) or locked (s = v = psi = 0)")
+    orbit.add_argument("--json", action="store_true", help="print one JSON object")
+    orbit.set_defaults(func=_cmd_orbit)
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "
                           "in parallel processes (make setup)")

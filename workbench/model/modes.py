@@ -41,15 +41,17 @@ ABOUT = ("undeformed", "static")
 FD_REL = 1e-6
 
 
-def linear_matrices(p: Parameters, joint: str = "locked",
-                    about: str = "undeformed") -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """M and K restricted to the moving coordinates (module docstring), and their names."""
+def linear_matrices(p: Parameters, joint: str = "locked", about: str = "undeformed",
+                    joint_at: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """M and K restricted to the moving coordinates (module docstring), and their names.
+    ``joint_at`` (q, 9 values; about "static" only): the locked joint's coordinates s, v, psi
+    are held at its values (default: centred, 0), e.g. where a run's contacts hold them."""
     if joint not in ("locked", "free"):
         raise ParameterError(f"joint must be 'locked' or 'free', got {joint!r}")
     if about not in ABOUT:
         raise ParameterError(f"about must be one of {ABOUT}, got {about!r}")
     if about == "static":
-        return _about_static(p, joint)
+        return _about_static(p, joint, joint_at)
     model = mdl.build(p, fixed=mdl.JOINT if joint == "locked" else ())
     work = mdl.make_work()
     zero = np.zeros(ly.N_DOF)
@@ -62,15 +64,18 @@ def linear_matrices(p: Parameters, joint: str = "locked",
     return M[np.ix_(f, f)], K[np.ix_(f, f)], [ly.COORD_NAMES[i] for i in f]
 
 
-def _about_static(p: Parameters, joint: str):
-    """M(q_s) and the tangent stiffness at the static equilibrium, joint locked."""
+def _about_static(p: Parameters, joint: str, joint_at: np.ndarray | None = None):
+    """M(q_s) and the tangent stiffness at the static equilibrium, joint locked (at
+    ``joint_at``'s s, v, psi if given)."""
     from ..core.equilibrium import static_state
     from .drives import none
     from .statics import static_equilibrium
     if joint != "locked":
         raise ParameterError("linearising about the static equilibrium needs the joint locked "
                              "(a free joint rests on its contacts): use about='undeformed'")
-    q_s = static_equilibrium(p, 0.0, mdl.JOINT).q
+    q_s = (static_equilibrium(p, 0.0, mdl.JOINT).q if joint_at is None else
+           static_equilibrium(p, 0.0, mdl.JOINT, s0=float(joint_at[ly.S]),
+                              q_guess=np.asarray(joint_at, float)[:ly.N_DOF]).q)
     model, work, ex = mdl.build(p, fixed=mdl.JOINT), mdl.make_work(), none()
     f = model.free
     case = (q_s.copy(), f, np.zeros(0, dtype=np.int64), False, 0.0)
@@ -147,8 +152,9 @@ def linear_damping(p: Parameters, joint: str = "locked") -> np.ndarray:
     return C
 
 
-def _state_matrix(p: Parameters, joint: str, about: str = "undeformed") -> np.ndarray:
-    M, K, _ = linear_matrices(p, joint, about)
+def _state_matrix(p: Parameters, joint: str, about: str = "undeformed",
+                  joint_at: np.ndarray | None = None) -> np.ndarray:
+    M, K, _ = linear_matrices(p, joint, about, joint_at)
     C = linear_damping(p, joint)
     _check_conditioned(M, K, joint)
     n = len(M)

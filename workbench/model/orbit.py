@@ -1,0 +1,407 @@
+"""Periodic responses of the sine-driven model by shooting, and their Floquet multipliers.
+
+A periodic orbit of K drive periods T = K / f is a fixed point of the K-period map: the
+state x = (q, q') at drive phase 0 and its regime (contact set, stick or slip) such that
+integrating K periods from x returns to x.  :func:`periodic_orbit` solves Phi(x) = x by
+Newton's method from a guess (by default the state after GUESS_PERIODS drive periods from the
+static equilibrium, the drive's soft start over the first RAMP_PERIODS).
+
+**Reduced coordinates.**  In a regime with closed contacts the state moves on the
+constraint manifold: the closed points' gaps are zero and so are their rates, and a sticking
+point's tangential rate (its tangential position is free: any position in the friction cone
+holds).  The orbit is sought, and its monodromy taken, in coordinates of the manifold's
+tangent space at x: orthonormal bases Nq of the null space of the normal rows and Nv of all
+active rows W (q-space), positions q + Nq a and rates q' + Nv b - W^+ (dW[Nq a]) q' (the
+correction keeps W(q) q' = 0 to first order).  Free flight: 18 coordinates; the stuck joint
+(two points closed, sticking) 7 + 6 = 13.
+
+**Monodromy.**  The Jacobian of the K-period map in those coordinates, by central finite
+differences of the map, 2 x dim integrations of K periods per Newton step (through every
+event of the orbit: away from grazing the map is smooth there).  Its eigenvalues are the
+Floquet multipliers (the reduced system's; the constrained directions have none); the
+orbit is stable when every |multiplier| < 1 (STABLE_MARGIN) but the neutral one: an orbit
+that sticks at phase 0 with no slip to move its stuck position is one of a family (friction
+holds it at any position in the cone), with a multiplier 1 along that position, reported as
+``neutral_multiplier`` and left out of the stability.
+
+**Residual.**  |Phi(x) - x| on the integrator's error scales (``core.error_scales``: each
+component's largest |value| over the orbit, its partner's, or the floor from the gap) —
+the orbit is found when the largest is at most ``newton_tol``.
+
+**Grazing.**  An orbit on which an open point's gap has a minimum in time within GRAZE_REL
+of the clearance of zero (it touches without closing) is flagged: its multipliers are not defined there (the map is not
+differentiable), and the status says so.
+
+Limits: only a sine drive (a forcing period); the finite-difference monodromy is the check
+of the variational equations with saltation matrices, which the workbench does not yet
+integrate (docs/usage.md).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import excitation as cx
+from ..core import layout as ly
+from ..core.config import REF_RATE
+from ..core.contact import eval_geometry
+from . import packing as mdl
+from .params import ParameterError, Parameters
+from .regimes import contact_code
+
+#: The guess: drive periods from the static equilibrium, the first RAMP_PERIODS a soft start.
+GUESS_PERIODS = 30
+RAMP_PERIODS = 5
+#: Newton: iterations at most, and the relative finite-difference step on the error scales.
+MAX_NEWTON = 15
+FD_REL = 1e-6
+#: The integrator's tolerance for the period map (tighter than the Newton tolerance by 100).
+MAP_TOL = 1e-9
+#: |multiplier| below 1 - STABLE_MARGIN is stable (the monodromy's own error is ~1e-6).
+STABLE_MARGIN = 1e-6
+#: A multiplier this close to 1 moving a stuck point's position is the friction-held family's.
+NEUTRAL_TOL = 1e-3
+#: An open gap within GRAZE_REL of the clearance of zero grazes.
+GRAZE_REL = 1e-4
+#: Samples a drive period of the orbit's record (the tip's amplitude, the gaps' minimum).
+SAMPLES_PER_PERIOD = 400
+
+
+@dataclass
+class Orbit:
+    """A periodic orbit found (or the last iterate of a search that was not)."""
+
+    status: str                       # "converged", "not converged", "grazing", "failed"
+    message: str
+    period_s: float
+    periods: int
+    state: np.ndarray                 # (q, q') at phase 0, (18,)
+    regime: int
+    residual: float
+    newton_iterations: int
+    multipliers: np.ndarray           # complex, largest modulus first
+    stable: bool | None
+    grazing: bool
+    min_open_gap_cm: float
+    events_per_period: dict
+    contact_time_share: dict
+    tip_amplitude_cm: float
+    wall_s: float
+    dimension: int
+    history: list = field(default_factory=list)     # the residual after each Newton step
+    neutral: complex | None = None    # the stuck position's multiplier (module docstring)
+    monodromy: np.ndarray | None = None   # the K-period map's Jacobian, reduced coordinates
+
+    def deciding(self) -> np.ndarray:
+        """The multipliers that decide the stability: all but the neutral one."""
+        if self.neutral is None:
+            return self.multipliers
+        i = int(np.argmin(np.abs(self.multipliers - self.neutral)))
+        return np.delete(self.multipliers, i)
+
+    def to_dict(self) -> dict:
+        """The JSON object of ``workbench orbit --json``."""
+        return {"status": self.status, "message": self.message, "period_s": self.period_s,
+                "periods": self.periods, "residual": self.residual,
+                "newton_iterations": self.newton_iterations,
+                "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
+                "stable": self.stable, "grazing": self.grazing,
+                "min_open_gap_cm": self.min_open_gap_cm,
+                "events_per_period": self.events_per_period,
+                "contact_time_share": self.contact_time_share,
+                "tip_amplitude_cm": self.tip_amplitude_cm, "wall_s": self.wall_s,
+                "regime": self.regime, "contact_code": int(contact_code(self.regime)),
+                "dimension": self.dimension, "monodromy": "finite-difference",
+                "neutral_multiplier": (None if self.neutral is None
+                                       else [self.neutral.real, self.neutral.imag]),
+                "residual_history": self.history, "state": self.state.tolist()}
+
+
+def sine_of(drive) -> tuple[np.ndarray, float]:
+    """The drive as a sine's excitation array without a soft start, and its frequency (Hz);
+    ``drive`` an excitation array (``drives.sine``) or settings {"drive": "sine", ...}."""
+    from . import drives
+    ex = drives.excitation_array(drive) if isinstance(drive, dict) else np.array(drive, float)
+    if int(ex[cx.X_KIND]) != cx.EXC_SINE:
+        raise ParameterError("a periodic orbit needs a sine drive (a forcing period); "
+                             f"got the drive {drives.of_array(ex).name!r}")
+    ex[cx.X_RAMP] = 0.0
+    return ex, float(ex[cx.X_FREQ])
+
+
+def constraint_rows(P: np.ndarray, q: np.ndarray, regime: int) -> np.ndarray:
+    """The active constraint rows W (m x 9) of a regime at q: the closed points' gap gradients
+    and, sticking, the first point's tangential gradient (docs/model.md §7)."""
+    k = (regime + 1) // 2
+    if k == 0:
+        return np.zeros((0, ly.N_DOF))
+    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
+    eval_geometry(q, P, cg)
+    rows = [ly.CG_G + p for p in (ly.SET_FIRST[k], ly.SET_SECOND[k]) if p >= 0]
+    if regime % 2 == 1:
+        rows.append(ly.CG_T + ly.SET_FIRST[k])
+    W = np.zeros((len(rows), ly.N_DOF))
+    for i, r in enumerate(rows):
+        W[i, ly.S], W[i, ly.V], W[i, ly.PSI] = cg[r, ly.CG_DS], cg[r, ly.CG_DV], cg[r, ly.CG_DPSI]
+    return W
+
+
+def _gaps(P, q, regime) -> np.ndarray:
+    k = (regime + 1) // 2
+    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
+    eval_geometry(q, P, cg)
+    return np.array([cg[ly.CG_G + p, ly.CG_VAL] for p in (ly.SET_FIRST[k], ly.SET_SECOND[k])
+                     if k and p >= 0])
+
+
+def _null_basis(W: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """An orthonormal basis (9 x d) of the moving coordinates' directions that W keeps at 0."""
+    W = W[:, free]
+    if len(W):
+        _, s, vt = np.linalg.svd(W)
+        rank = int(np.sum(s > 1e-12 * max(1.0, s.max())))
+    else:
+        vt, rank = np.eye(len(free)), 0
+    N = np.zeros((ly.N_DOF, len(free) - rank))
+    N[free] = vt[rank:].T
+    return N
+
+
+class Manifold:
+    """The reduced coordinates of a regime about a state (module docstring): positions in the
+    null space of the closed points' normal rows (a sticking point's tangential position is
+    free: any position in the friction cone holds), rates in that of every active row."""
+
+    def __init__(self, P, x, regime, free):
+        self.P, self.regime = P, regime
+        self.n_normal = len(_gaps(P, x[:ly.N_DOF], regime))
+        W = constraint_rows(P, x[:ly.N_DOF], regime)
+        self.Nq, self.Nv = _null_basis(W[:self.n_normal], free), _null_basis(W, free)
+        self.dim = self.Nq.shape[1] + self.Nv.shape[1]
+
+    def _rates_fix(self, x, dq):
+        """-W^+ (dW[dq]) q': keeps W q' = 0 to first order when q moves by dq."""
+        W = constraint_rows(self.P, x[:ly.N_DOF], self.regime)
+        if not len(W) or not np.any(dq):
+            return np.zeros(ly.N_DOF)
+        h = 1e-7 / np.abs(dq).max()
+        dW = (constraint_rows(self.P, x[:ly.N_DOF] + h * dq, self.regime)
+              - constraint_rows(self.P, x[:ly.N_DOF] - h * dq, self.regime)) / (2 * h)
+        return -np.linalg.pinv(W) @ (dW @ x[ly.N_DOF:])
+
+    def move(self, x, z):
+        """x moved by reduced coordinates z (first order on the manifold)."""
+        m = self.Nq.shape[1]
+        dq = self.Nq @ z[:m]
+        out = x.copy()
+        out[:ly.N_DOF] += dq
+        out[ly.N_DOF:] += self.Nv @ z[m:] + self._rates_fix(x, dq)
+        return out
+
+    def coordinates(self, dx):
+        """The reduced coordinates of a state difference dx."""
+        return np.concatenate([self.Nq.T @ dx[:ly.N_DOF], self.Nv.T @ dx[ly.N_DOF:]])
+
+    def project(self, x):
+        """x back onto the manifold: the closed gaps to zero (Gauss-Newton in the normal
+        rows' span), then the rates onto W q' = 0."""
+        out = x.copy()
+        for _ in range(5):
+            g = _gaps(self.P, out[:ly.N_DOF], self.regime)
+            if not len(g) or np.abs(g).max() < 1e-13:
+                break
+            W = constraint_rows(self.P, out[:ly.N_DOF], self.regime)[:len(g)]
+            out[:ly.N_DOF] -= np.linalg.pinv(W) @ g
+        W = constraint_rows(self.P, out[:ly.N_DOF], self.regime)
+        if len(W):
+            out[ly.N_DOF:] -= np.linalg.pinv(W) @ (W @ out[ly.N_DOF:])
+        return out
+
+
+def error_scales(P, states: np.ndarray) -> np.ndarray:
+    """The integrator's error scale of each component of (q, q') over a record of states
+    (``core.error_scales``: the floor from the clearance, the largest |value| of it or its
+    partner)."""
+    from ..core.error_scales import PARTNER
+    floor = np.full(ly.N_DOF, P[ly.P_GAP])
+    floor[ly.PHI_A] /= P[ly.P_L_A]
+    floor[ly.PHI_B] /= P[ly.P_L_B]
+    floor[ly.PSI] /= P[ly.P_L4]
+    floor = np.concatenate([floor, REF_RATE * floor])
+    peak = np.abs(states[:, :ly.N_STATE]).max(axis=0)
+    partner = np.concatenate([peak[:ly.N_DOF][list(PARTNER)],
+                              peak[ly.N_DOF:][list(PARTNER)]])
+    return np.maximum.reduce([floor, peak, partner])
+
+
+def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
+                   newton_tol: float = 1e-7, max_newton: int = MAX_NEWTON,
+                   fixed=()) -> Orbit:
+    """A periodic orbit of ``periods`` drive periods (module docstring).
+
+    ``drive``: a sine (``drives.sine(force_n, freq_hz)`` or its settings; the soft start is
+    dropped).  ``guess``: (state (18,), regime) to start Newton from; by default the state
+    after GUESS_PERIODS periods from the static equilibrium.  Returns an :class:`Orbit`
+    whose ``status`` says whether it was found; never one it did not find.
+    """
+    from .simulate import simulate
+    t_wall = time.perf_counter()
+    if not isinstance(params, Parameters):
+        raise ParameterError(f"params must be Parameters, got {type(params).__name__}")
+    if not isinstance(periods, (int, np.integer)) or isinstance(periods, bool) or periods < 1:
+        raise ParameterError(f"periods = {periods!r}: a whole number of drive periods, >= 1")
+    ex, f = sine_of(drive)
+    T = periods / f
+    dt, output_hz = lattice(params, ex, 1.0 / f)
+    model = mdl.build(params, fixed=fixed)
+    P, free = model.P, np.array(model.free)
+
+    def run(x, regime, duration):
+        return simulate(params, ex, duration, initial=x[:ly.N_STATE], regime=regime,
+                        tol=MAP_TOL, dt=dt, output_hz=output_hz, fixed=fixed)
+
+    if guess is None:
+        ramped = ex.copy()
+        ramped[cx.X_RAMP] = RAMP_PERIODS / f
+        start = simulate(params, ramped, GUESS_PERIODS / f, tol=MAP_TOL, dt=dt,
+                         output_hz=output_hz, fixed=fixed)
+        if not start.ok:
+            return _failed(f"the guess run failed: {start.message}", T, periods, t_wall)
+        x, regime = start.states[-1, :ly.N_STATE].copy(), int(start.signal("regime")[-1])
+    else:
+        x, regime = np.array(guess[0], float)[:ly.N_STATE].copy(), int(guess[1])
+    history, status, message = [], "not converged", f"no fixed point in {max_newton} steps"
+    iterations, J, record = 0, None, None
+    for iterations in range(1, max_newton + 1):
+        manifold = Manifold(P, x, regime, free)
+        x = manifold.project(x)
+        record = run(x, regime, T)
+        if not record.ok:
+            return _failed(f"the period map failed: {record.message}", T, periods, t_wall)
+        end_regime = int(record.signal("regime")[-1])
+        scale = error_scales(P, record.states)
+        res_vec = record.states[-1, :ly.N_STATE] - x
+        residual = float(np.max(np.abs(res_vec) / scale))
+        history.append(residual)
+        if end_regime != regime:
+            message = (f"the period map ends in regime {end_regime}, not {regime}: the iterate "
+                       "is not near an orbit of this regime")
+            if iterations == max_newton:
+                break
+            x, regime = record.states[-1, :ly.N_STATE].copy(), end_regime   # one period on
+            continue
+        J = _monodromy(manifold, x, regime, scale, run, T)
+        if residual <= newton_tol:
+            status, message = "converged", "found"
+            break
+        step = np.linalg.lstsq(J - np.eye(manifold.dim), -manifold.coordinates(res_vec),
+                               rcond=None)[0]
+        x = manifold.move(x, step)
+    manifold = Manifold(P, x, regime, free)
+    multipliers, neutral = _floquet(J, manifold, x, error_scales(P, record.states))
+    facts = _orbit_facts(record, P, periods, T)
+    if status == "converged" and facts["grazing"]:
+        status, message = "grazing", ("found, but an open gap grazes zero: the multipliers are "
+                                      "not defined there")
+    others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
+    stable = (bool(others.max(initial=0.0) < 1.0 - STABLE_MARGIN)
+              if status == "converged" else None)
+    return Orbit(status, message, T, periods, x, regime, history[-1] if history else np.inf,
+                 iterations, multipliers, stable, facts["grazing"], facts["min_open_gap_cm"],
+                 facts["events_per_period"], facts["contact_time_share"],
+                 facts["tip_amplitude_cm"], time.perf_counter() - t_wall, manifold.dim, history,
+                 None if neutral is None else complex(multipliers[neutral]), J)
+
+
+def lattice(params, ex, period_s: float) -> tuple[float, float]:
+    """(largest step, sample rate) with a whole number of both in a drive period: the step at
+    most the default (``step_policy.default_dt``), about SAMPLES_PER_PERIOD samples a period,
+    so that a run of whole periods ends exactly at the drive's phase 0."""
+    from .step_policy import default_dt
+    n = int(np.ceil(period_s / default_dt(params, ex) - 1e-9))
+    decim = max(1, int(np.ceil(n / SAMPLES_PER_PERIOD)))
+    n = decim * int(np.ceil(n / decim))
+    dt = period_s / n
+    return dt, 1.0 / (decim * dt)
+
+
+def reduced_scales(manifold, scale) -> np.ndarray:
+    """The error scale of each reduced coordinate: its basis vector's weighted mean of the
+    components' scales (cm, rad and per s)."""
+    Nq, Nv = np.abs(manifold.Nq), np.abs(manifold.Nv)
+    return np.concatenate([Nq.T @ scale[:ly.N_DOF] / Nq.sum(axis=0),
+                           Nv.T @ scale[ly.N_DOF:] / Nv.sum(axis=0)])
+
+
+def _monodromy(manifold, x, regime, scale, run, T) -> np.ndarray:
+    """The K-period map's Jacobian in the reduced coordinates, by central differences."""
+    J = np.empty((manifold.dim, manifold.dim))
+    steps = FD_REL * reduced_scales(manifold, scale)
+    for j in range(manifold.dim):
+        z = np.zeros(manifold.dim)
+        z[j] = steps[j]
+        ends = []
+        for sign in (1.0, -1.0):
+            r = run(manifold.move(x, sign * z), regime, T)
+            if not r.ok:
+                raise ParameterError(f"the period map failed at a perturbed state: {r.message}")
+            ends.append(r.states[-1, :ly.N_STATE])
+        J[:, j] = manifold.coordinates(ends[0] - ends[1]) / (2 * steps[j])
+    return J
+
+
+def _floquet(J, manifold, x, scale) -> tuple[np.ndarray, int | None]:
+    """The multipliers, largest modulus first, and the index of the neutral one: in a regime
+    that sticks at phase 0, the multiplier within NEUTRAL_TOL of 1 whose eigenvector (on the
+    error scales) moves mostly the stuck point's tangential position (a family of orbits held
+    by friction at any position)."""
+    if J is None:
+        return np.zeros(0, complex), None
+    d = reduced_scales(manifold, scale)
+    mu, vec = np.linalg.eig(J)
+    vec = vec / d[:, None]
+    order = np.argsort(-np.abs(mu), kind="stable")
+    mu, vec = mu[order], vec[:, order]
+    if manifold.regime % 2 == 0 or manifold.regime == 0:
+        return mu, None
+    W = constraint_rows(manifold.P, x[:ly.N_DOF], manifold.regime)
+    along = manifold.Nq.T @ W[-1]
+    along /= max(np.linalg.norm(along), 1e-300)
+    m = manifold.Nq.shape[1]
+    share = np.abs(along @ vec[:m]) / np.linalg.norm(vec, axis=0)
+    candidates = np.flatnonzero((np.abs(mu - 1.0) < NEUTRAL_TOL) & (share > 0.5))
+    return mu, (int(candidates[np.argmax(share[candidates])]) if len(candidates) else None)
+
+
+def _orbit_facts(record, P, periods, T) -> dict:
+    """Events per drive period by kind, contact-time shares, the tip's amplitude and the
+    smallest open gap over the orbit's record."""
+    kinds = record.log[:, ly.LOG_KIND]
+    per = {name: float((kinds == code).sum()) / periods
+           for code, name in enumerate(ly.EVENT_KINDS) if code != ly.KIND_START}
+    tip = record.signal("tip_y")
+    regimes = record.signal("regime").astype(int)
+    gaps = np.stack([record.signal(f"gap{k + 1}") for k in range(ly.N_POINTS)], axis=1)
+    closed = np.zeros_like(gaps, dtype=bool)
+    for i, r in enumerate(regimes):
+        k = (r + 1) // 2
+        for p in (ly.SET_FIRST[k], ly.SET_SECOND[k]):
+            if k and p >= 0:
+                closed[i, p] = True
+    open_gaps = np.where(closed, np.inf, gaps)
+    # a graze: an open gap's minimum in time (not the approach to a closing)
+    inner = ((open_gaps[1:-1] < open_gaps[:-2]) & (open_gaps[1:-1] <= open_gaps[2:])
+             & np.isfinite(open_gaps[:-2]) & np.isfinite(open_gaps[2:]))
+    minima = open_gaps[1:-1][inner]
+    smallest = float(minima.min()) if len(minima) else float("inf")
+    return {"events_per_period": per, "contact_time_share": record.contact_time_share(),
+            "tip_amplitude_cm": float((tip.max() - tip.min()) / 2.0),
+            "min_open_gap_cm": smallest, "grazing": bool(smallest < GRAZE_REL * P[ly.P_GAP])}
+
+
+def _failed(message, T, periods, t_wall) -> Orbit:
+    return Orbit("failed", message, T, periods, np.full(ly.N_STATE, np.nan), 0, float("inf"),
+                 0, np.zeros(0, complex), None, False, float("nan"), {}, {}, float("nan"),
+                 time.perf_counter() - t_wall, 0)
