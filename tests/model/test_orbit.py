@@ -27,7 +27,7 @@ def test_the_stuck_joints_orbit_has_the_locked_models_multipliers():
     at the finite differences' floor, 2e-4 absolute."""
     p = Parameters()
     orbit = periodic_orbit(p, drives.sine(0.5, 20.0))
-    assert orbit.status == "converged" and orbit.residual <= 1e-7, orbit.message
+    assert orbit.status == "ok" and orbit.residual <= 1e-7, orbit.message
     assert orbit.dimension == 13 and sum(orbit.events_per_period.values()) == 0
     assert abs(orbit.neutral - 1.0) < 1e-6 and orbit.stable
     lam = np.linalg.eigvals(_state_matrix(p, "locked", "static", orbit.state[:ly.N_DOF]))
@@ -54,7 +54,7 @@ def test_a_stick_slip_orbit_is_found_and_a_run_from_near_it_stays_on_it(stick_sl
     position's left out, are inside the unit circle), and its every period passes through
     the same events."""
     orbit = stick_slip_orbit
-    assert orbit.status == "converged" and orbit.stable, orbit.to_dict()
+    assert orbit.status == "ok" and orbit.stable, orbit.to_dict()
     assert orbit.events_per_period["impact"] == 2 and orbit.events_per_period["stick-slip"] > 10
     assert abs(orbit.deciding()).max() < 1.0 and orbit.neutral is not None
     p, f = Parameters(), 30.0
@@ -81,7 +81,7 @@ def test_the_orbit_command_prints_the_json_the_issue_names(capsys):
                 "stable", "events_per_period", "contact_time_share", "tip_amplitude_cm",
                 "wall_s", "grazing"):
         assert key in out, key
-    assert out["status"] == "converged" and out["period_s"] == pytest.approx(0.05)
+    assert out["status"] == "ok" and out["period_s"] == pytest.approx(0.05)
     assert all(len(m) == 2 for m in out["multipliers"])
     moduli = [abs(complex(*m)) for m in out["multipliers"]]
     assert moduli == sorted(moduli, reverse=True)

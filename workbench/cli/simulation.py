@@ -13,7 +13,7 @@ from ..model.limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MA
                             MIN_DT)
 from ..model.params import ParameterError, describe
 from ..model.shown_units import SI
-from ..study.paths import check_output_file
+from ..study.paths import check_output_dir, check_output_file
 from .common import (EXIT_INTERNAL, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_RUN_FAILED,
                      add_drive_options, add_joint_options, add_model_options, json_text, number,
                      parameters_of, shortcut_drive)
@@ -223,7 +223,60 @@ def _cmd_orbit(args) -> int:
             + (", ".join(f"{k} {v:g}" for k, v in orbit.events_per_period.items() if v) or "none"),
             f"{'tip amplitude':>20}: {_plain(orbit.tip_amplitude_cm * SI['cm'][1])} mm",
             f"{'wall':>20}: {orbit.wall_s:.3g} s"]))
-    return EXIT_OK if orbit.status == "converged" else EXIT_NOT_CONVERGED
+    return EXIT_OK if orbit.status == "ok" else EXIT_NOT_CONVERGED
+
+
+def value_or_range(text: str):
+    """A number, or LO:HI (two numbers, LO below HI)."""
+    import argparse
+    parts = text.split(":")
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number or LO:HI") from None
+    if len(values) == 1:
+        return values[0]
+    if len(values) != 2 or not values[0] < values[1] or not all(map(math.isfinite, values)):
+        raise argparse.ArgumentTypeError(f"{text!r}: a range is LO:HI with LO below HI")
+    return tuple(values)
+
+
+def _cmd_continue(args) -> int:
+    from ..model import drives
+    from ..model.continuation import branch_rows, continue_branch
+    from ..model.orbit import Shooter
+    from ..model.packing import JOINT
+    from ..present.branch import write_branch
+    from .common import RESULTS
+    ranges = [(name, v) for name, v in (("freq_hz", args.freq_hz), ("force_n", args.force_n))
+              if isinstance(v, tuple)]
+    if len(ranges) != 1:
+        raise ParameterError("give one of --freq-hz and --force-n as a range LO:HI (the other "
+                             "a value)")
+    parameter, (lo, hi) = ranges[0]
+    option = "--" + parameter.replace("_", "-")
+    if parameter == "freq_hz" and lo <= 0:
+        raise ParameterError(f"{option} {lo:g}:{hi:g}: allowed (0, inf) Hz")
+    if parameter == "force_n" and not 0 < lo and hi <= MAX_FORCE_N:
+        raise ParameterError(f"{option} {lo:g}:{hi:g}: allowed (0, {MAX_FORCE_N:g}] N")
+    p = parameters_of(args)
+    freq = lo if parameter == "freq_hz" else args.freq_hz
+    force = lo if parameter == "force_n" else args.force_n
+    out = check_output_dir("--out", args.out or RESULTS / "continue" / f"{parameter}-{lo:g}-{hi:g}")
+    shooter = Shooter(p, drives.sine(force, freq), args.periods,
+                      JOINT if args.joint == "locked" else (), parameter)
+    branch = continue_branch(shooter, lo, hi, on_orbit=lambda b: write_branch(b, out, p))
+    rows = branch_rows(branch)
+    summary = {"status": branch.status, "message": branch.message, "parameter": parameter,
+               "range": [lo, hi], "orbits": len(rows),
+               "stable": int(sum(r["stable"] for r in rows)),
+               "bifurcations": [{"at": rows[i][parameter], "kind": k}
+                                for i, k in branch.bifurcations],
+               "wall_s": branch.wall_s, "out": str(out)}
+    print(json_text(summary) if args.json else
+          f"{branch.status}: {branch.message}; {len(rows)} orbits, {summary['stable']} stable, "
+          f"{len(branch.bifurcations)} bifurcation(s); wrote {out}")
+    return EXIT_OK if branch.status == "done" else EXIT_NOT_CONVERGED
 
 
 def _cmd_params(args) -> int:
@@ -294,6 +347,7 @@ def add_parsers(sub) -> None:
     orbit = sub.add_parser("orbit", help="a periodic response of a sine drive by shooting, and "
                            "its Floquet multipliers (model/orbit.py)")
     add_model_options(orbit)
+    add_joint_options(orbit)
     orbit.add_argument("--freq-hz", type=number(0, lo_open=True), required=True,
                        help="the sine's frequency (Hz)")
     orbit.add_argument("--force-n", type=number(0, MAX_FORCE_N, lo_open=True),
@@ -305,6 +359,23 @@ def add_parsers(sub) -> None:
                        help="free (default) or locked (s = v = psi = 0)")
     orbit.add_argument("--json", action="store_true", help="print one JSON object")
     orbit.set_defaults(func=_cmd_orbit)
+
+    cont = sub.add_parser("continue", help="a branch of periodic orbits over the drive's "
+                          "frequency or force (model/continuation.py)")
+    add_model_options(cont)
+    add_joint_options(cont)
+    cont.add_argument("--freq-hz", type=value_or_range, required=True,
+                      help="the sine's frequency (Hz), or LO:HI to continue over it")
+    cont.add_argument("--force-n", type=value_or_range, default=drives.DEFAULT_FORCE_N,
+                      help=f"the sine's amplitude (N; default {drives.DEFAULT_FORCE_N:g}), or "
+                      "LO:HI to continue over it")
+    cont.add_argument("--periods", type=number(1, 64, integer=True), default=1,
+                      help="drive periods of the orbits (default 1)")
+    cont.add_argument("--joint", choices=("free", "locked"), default="free",
+                      help="free (default) or locked (s = v = psi = 0)")
+    cont.add_argument("--out", help="output folder (default results/continue/<parameter>-LO-HI)")
+    cont.add_argument("--json", action="store_true", help="print a one-line JSON summary")
+    cont.set_defaults(func=_cmd_continue)
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "
                           "in parallel processes (make setup)")

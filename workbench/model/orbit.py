@@ -19,10 +19,11 @@ correction keeps W(q) q' = 0 to first order).  Free flight: 18 coordinates; the 
 differences of the map, 2 x dim integrations of K periods per Newton step (through every
 event of the orbit: away from grazing the map is smooth there).  Its eigenvalues are the
 Floquet multipliers (the reduced system's; the constrained directions have none); the
-orbit is stable when every |multiplier| < 1 (STABLE_MARGIN) but the neutral one: an orbit
-that sticks at phase 0 with no slip to move its stuck position is one of a family (friction
-holds it at any position in the cone), with a multiplier 1 along that position, reported as
-``neutral_multiplier`` and left out of the stability.
+orbit is stable when every |multiplier| < 1 (STABLE_MARGIN) but the neutral one: where
+friction holds the loose body, the orbit is one of a family (held at any position in the
+cone: shifted along the slide it is still an orbit, the cork's pull aside), with a multiplier
+1 along the body's tangential position, reported as ``neutral_multiplier`` and left out of
+the stability (NEUTRAL_TOL).
 
 **Residual.**  |Phi(x) - x| on the integrator's error scales (``core.error_scales``: each
 component's largest |value| over the orbit, its partner's, or the floor from the gap) —
@@ -61,8 +62,10 @@ FD_REL = 1e-6
 MAP_TOL = 1e-9
 #: |multiplier| below 1 - STABLE_MARGIN is stable (the monodromy's own error is ~1e-6).
 STABLE_MARGIN = 1e-6
-#: A multiplier this close to 1 moving a stuck point's position is the friction-held family's.
-NEUTRAL_TOL = 1e-3
+#: A multiplier this close to 1 moving the body's tangential position is the friction-held
+#: family's (measured: 1 - 1e-9 on the stuck joint, 1 + 4e-4 with 15 stick-slip cycles a
+#: period, 1 + 1e-4 to 3e-3 rocking at 200 N: the finite differences through the events).
+NEUTRAL_TOL = 5e-3
 #: An open gap within GRAZE_REL of the clearance of zero grazes.
 GRAZE_REL = 1e-4
 #: Samples a drive period of the orbit's record (the tip's amplitude, the gaps' minimum).
@@ -73,7 +76,7 @@ SAMPLES_PER_PERIOD = 400
 class Orbit:
     """A periodic orbit found (or the last iterate of a search that was not)."""
 
-    status: str                       # "converged", "not converged", "grazing", "failed"
+    status: str                       # "ok" (found), "not converged", "grazing", "failed"
     message: str
     period_s: float
     periods: int
@@ -93,6 +96,9 @@ class Orbit:
     history: list = field(default_factory=list)     # the residual after each Newton step
     neutral: complex | None = None    # the stuck position's multiplier (module docstring)
     monodromy: np.ndarray | None = None   # the K-period map's Jacobian, reduced coordinates
+    responses: dict = field(default_factory=dict)   # amplitude and RMS of accel1-3 (cm/s²) and
+                                                    # strain1-2 over the orbit
+    tip_rms_cm: float = float("nan")
 
     def deciding(self) -> np.ndarray:
         """The multipliers that decide the stability: all but the neutral one."""
@@ -111,7 +117,8 @@ class Orbit:
                 "min_open_gap_cm": self.min_open_gap_cm,
                 "events_per_period": self.events_per_period,
                 "contact_time_share": self.contact_time_share,
-                "tip_amplitude_cm": self.tip_amplitude_cm, "wall_s": self.wall_s,
+                "tip_amplitude_cm": self.tip_amplitude_cm, "tip_rms_cm": self.tip_rms_cm,
+                **self.responses, "wall_s": self.wall_s,
                 "regime": self.regime, "contact_code": int(contact_code(self.regime)),
                 "dimension": self.dimension, "monodromy": "finite-difference",
                 "neutral_multiplier": (None if self.neutral is None
@@ -236,6 +243,122 @@ def error_scales(P, states: np.ndarray) -> np.ndarray:
     return np.maximum.reduce([floor, peak, partner])
 
 
+class Shooter:
+    """The K-period map of a sine drive and what Newton's method needs of it; the drive's
+    frequency or force may be a parameter (``parameter``: "freq_hz" or "force_n", for
+    continuation)."""
+
+    def __init__(self, params: Parameters, drive, periods: int = 1, fixed=(),
+                 parameter: str | None = None):
+        if not isinstance(params, Parameters):
+            raise ParameterError(f"params must be Parameters, got {type(params).__name__}")
+        if not isinstance(periods, (int, np.integer)) or isinstance(periods, bool) or periods < 1:
+            raise ParameterError(f"periods = {periods!r}: a whole number of drive periods, >= 1")
+        if parameter not in (None, "freq_hz", "force_n"):
+            raise ParameterError(f"parameter = {parameter!r}: allowed freq_hz, force_n")
+        self.params, self.periods, self.fixed, self.parameter = params, int(periods), fixed, parameter
+        self.ex, _ = sine_of(drive)
+        model = mdl.build(params, fixed=fixed)
+        self.P, self.free = model.P, np.array(model.free)
+
+    def value(self, ex=None) -> float:
+        """The parameter's value (Hz or N) of an excitation array (default the drive's)."""
+        ex = self.ex if ex is None else ex
+        return float(ex[cx.X_FREQ] if self.parameter == "freq_hz" else ex[cx.X_AMP] / 1e5)
+
+    def drive_at(self, value: float | None) -> np.ndarray:
+        """The drive with the parameter at ``value`` (None: the drive as given)."""
+        ex = self.ex.copy()
+        if value is not None:
+            if self.parameter == "freq_hz":
+                ex[cx.X_FREQ] = value
+            else:
+                ex[cx.X_AMP] = value * 1e5
+        return ex
+
+    def period_s(self, ex) -> float:
+        return self.periods / float(ex[cx.X_FREQ])
+
+    def run(self, x, regime, ex, periods: int | None = None):
+        """``periods`` (default K) drive periods from (x, regime) at phase 0."""
+        from .simulate import simulate
+        f = float(ex[cx.X_FREQ])
+        dt, rate = lattice(self.params, ex, 1.0 / f)
+        return simulate(self.params, ex, (periods or self.periods) / f, initial=x[:ly.N_STATE],
+                        regime=regime, tol=MAP_TOL, dt=dt, output_hz=rate, fixed=self.fixed)
+
+    def guess(self, ex) -> tuple[np.ndarray, int]:
+        """The state and regime after GUESS_PERIODS periods from the static equilibrium, the
+        first RAMP_PERIODS a soft start; ParameterError if that run fails."""
+        from .simulate import simulate
+        f = float(ex[cx.X_FREQ])
+        ramped = ex.copy()
+        ramped[cx.X_RAMP] = RAMP_PERIODS / f
+        dt, rate = lattice(self.params, ex, 1.0 / f)
+        start = simulate(self.params, ramped, GUESS_PERIODS / f, tol=MAP_TOL, dt=dt,
+                         output_hz=rate, fixed=self.fixed)
+        if not start.ok:
+            raise ParameterError(f"the guess run failed: {start.message}")
+        return start.states[-1, :ly.N_STATE].copy(), int(start.signal("regime")[-1])
+
+    def manifold(self, x, regime) -> "Manifold":
+        return Manifold(self.P, x, regime, self.free)
+
+    def residual(self, x, regime, ex):
+        """(record, Phi(x) - x, error scales, largest scaled residual, end regime)."""
+        record = self.run(x, regime, ex)
+        if not record.ok:
+            raise ParameterError(f"the period map failed: {record.message}")
+        scale = error_scales(self.P, record.states)
+        res = record.states[-1, :ly.N_STATE] - x
+        return (record, res, scale, float(np.max(np.abs(res) / scale)),
+                int(record.signal("regime")[-1]))
+
+    def monodromy(self, manifold, x, regime, ex, scale) -> np.ndarray:
+        """The K-period map's Jacobian in the reduced coordinates, by central differences."""
+        J = np.empty((manifold.dim, manifold.dim))
+        steps = FD_REL * reduced_scales(manifold, scale)
+        for j in range(manifold.dim):
+            z = np.zeros(manifold.dim)
+            z[j] = steps[j]
+            ends = [self._end(manifold.move(x, sign * z), regime, ex) for sign in (1.0, -1.0)]
+            J[:, j] = manifold.coordinates(ends[0] - ends[1]) / (2 * steps[j])
+        return J
+
+    def d_parameter(self, manifold, x, regime, value: float) -> np.ndarray:
+        """d(Phi(x) - x)/d(parameter) in the reduced coordinates (per Hz or per N)."""
+        h = FD_REL * max(abs(value), 1.0) * 100.0
+        ends = [self._end(x, regime, self.drive_at(value + sign * h)) for sign in (1.0, -1.0)]
+        return manifold.coordinates(ends[0] - ends[1]) / (2 * h)
+
+    def _end(self, x, regime, ex) -> np.ndarray:
+        r = self.run(x, regime, ex)
+        if not r.ok:
+            raise ParameterError(f"the period map failed at a perturbed state: {r.message}")
+        return r.states[-1, :ly.N_STATE]
+
+    def orbit(self, x, regime, ex, record, J, history, iterations, status, message,
+              t_wall) -> "Orbit":
+        """The :class:`Orbit` at a solution (or the last iterate) with its multipliers and the
+        facts of its record."""
+        T = self.period_s(ex)
+        manifold = self.manifold(x, regime)
+        multipliers, neutral = _floquet(J, manifold, x, error_scales(self.P, record.states))
+        facts = _orbit_facts(record, self.P, self.periods, T)
+        if status == "ok" and facts["grazing"]:
+            status, message = "grazing", ("found, but an open gap grazes zero: the multipliers "
+                                          "are not defined there")
+        others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
+        stable = bool(others.max(initial=0.0) < 1.0 - STABLE_MARGIN) if status == "ok" else None
+        return Orbit(status, message, T, self.periods, x, regime,
+                     history[-1] if history else np.inf, iterations, multipliers, stable,
+                     facts["grazing"], facts["min_open_gap_cm"], facts["events_per_period"],
+                     facts["contact_time_share"], facts["tip_amplitude_cm"],
+                     time.perf_counter() - t_wall, manifold.dim, history,
+                     None if neutral is None else complex(multipliers[neutral]), J,
+                     facts["responses"], facts["tip_rms_cm"])
+
+
 def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
                    newton_tol: float = 1e-7, max_newton: int = MAX_NEWTON,
                    fixed=()) -> Orbit:
@@ -246,73 +369,37 @@ def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
     after GUESS_PERIODS periods from the static equilibrium.  Returns an :class:`Orbit`
     whose ``status`` says whether it was found; never one it did not find.
     """
-    from .simulate import simulate
     t_wall = time.perf_counter()
-    if not isinstance(params, Parameters):
-        raise ParameterError(f"params must be Parameters, got {type(params).__name__}")
-    if not isinstance(periods, (int, np.integer)) or isinstance(periods, bool) or periods < 1:
-        raise ParameterError(f"periods = {periods!r}: a whole number of drive periods, >= 1")
-    ex, f = sine_of(drive)
-    T = periods / f
-    dt, output_hz = lattice(params, ex, 1.0 / f)
-    model = mdl.build(params, fixed=fixed)
-    P, free = model.P, np.array(model.free)
-
-    def run(x, regime, duration):
-        return simulate(params, ex, duration, initial=x[:ly.N_STATE], regime=regime,
-                        tol=MAP_TOL, dt=dt, output_hz=output_hz, fixed=fixed)
-
-    if guess is None:
-        ramped = ex.copy()
-        ramped[cx.X_RAMP] = RAMP_PERIODS / f
-        start = simulate(params, ramped, GUESS_PERIODS / f, tol=MAP_TOL, dt=dt,
-                         output_hz=output_hz, fixed=fixed)
-        if not start.ok:
-            return _failed(f"the guess run failed: {start.message}", T, periods, t_wall)
-        x, regime = start.states[-1, :ly.N_STATE].copy(), int(start.signal("regime")[-1])
-    else:
-        x, regime = np.array(guess[0], float)[:ly.N_STATE].copy(), int(guess[1])
+    shooter = Shooter(params, drive, periods, fixed)
+    ex = shooter.ex
+    try:
+        x, regime = shooter.guess(ex) if guess is None else (
+            np.array(guess[0], float)[:ly.N_STATE].copy(), int(guess[1]))
+    except ParameterError as exc:
+        return _failed(str(exc), shooter.period_s(ex), periods, t_wall)
     history, status, message = [], "not converged", f"no fixed point in {max_newton} steps"
     iterations, J, record = 0, None, None
-    for iterations in range(1, max_newton + 1):
-        manifold = Manifold(P, x, regime, free)
-        x = manifold.project(x)
-        record = run(x, regime, T)
-        if not record.ok:
-            return _failed(f"the period map failed: {record.message}", T, periods, t_wall)
-        end_regime = int(record.signal("regime")[-1])
-        scale = error_scales(P, record.states)
-        res_vec = record.states[-1, :ly.N_STATE] - x
-        residual = float(np.max(np.abs(res_vec) / scale))
-        history.append(residual)
-        if end_regime != regime:
-            message = (f"the period map ends in regime {end_regime}, not {regime}: the iterate "
-                       "is not near an orbit of this regime")
-            if iterations == max_newton:
+    try:
+        for iterations in range(1, max_newton + 1):
+            manifold = shooter.manifold(x, regime)
+            x = manifold.project(x)
+            record, res, scale, residual, end_regime = shooter.residual(x, regime, ex)
+            history.append(residual)
+            if end_regime != regime:
+                message = (f"the period map ends in regime {end_regime}, not {regime}: the "
+                           "iterate is not near an orbit of this regime")
+                x, regime = record.states[-1, :ly.N_STATE].copy(), end_regime   # one period on
+                continue
+            J = shooter.monodromy(manifold, x, regime, ex, scale)
+            if residual <= newton_tol:
+                status, message = "ok", "found"
                 break
-            x, regime = record.states[-1, :ly.N_STATE].copy(), end_regime   # one period on
-            continue
-        J = _monodromy(manifold, x, regime, scale, run, T)
-        if residual <= newton_tol:
-            status, message = "converged", "found"
-            break
-        step = np.linalg.lstsq(J - np.eye(manifold.dim), -manifold.coordinates(res_vec),
-                               rcond=None)[0]
-        x = manifold.move(x, step)
-    manifold = Manifold(P, x, regime, free)
-    multipliers, neutral = _floquet(J, manifold, x, error_scales(P, record.states))
-    facts = _orbit_facts(record, P, periods, T)
-    if status == "converged" and facts["grazing"]:
-        status, message = "grazing", ("found, but an open gap grazes zero: the multipliers are "
-                                      "not defined there")
-    others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
-    stable = (bool(others.max(initial=0.0) < 1.0 - STABLE_MARGIN)
-              if status == "converged" else None)
-    return Orbit(status, message, T, periods, x, regime, history[-1] if history else np.inf,
-                 iterations, multipliers, stable, facts["grazing"], facts["min_open_gap_cm"],
-                 facts["events_per_period"], facts["contact_time_share"],
-                 facts["tip_amplitude_cm"], time.perf_counter() - t_wall, manifold.dim, history,
-                 None if neutral is None else complex(multipliers[neutral]), J)
+            step = np.linalg.lstsq(J - np.eye(manifold.dim), -manifold.coordinates(res),
+                                   rcond=None)[0]
+            x = manifold.move(x, step)
+    except ParameterError as exc:
+        return _failed(str(exc), shooter.period_s(ex), periods, t_wall)
+    return shooter.orbit(x, regime, ex, record, J, history, iterations, status, message, t_wall)
 
 
 def lattice(params, ex, period_s: float) -> tuple[float, float]:
@@ -335,28 +422,26 @@ def reduced_scales(manifold, scale) -> np.ndarray:
                            Nv.T @ scale[ly.N_DOF:] / Nv.sum(axis=0)])
 
 
-def _monodromy(manifold, x, regime, scale, run, T) -> np.ndarray:
-    """The K-period map's Jacobian in the reduced coordinates, by central differences."""
-    J = np.empty((manifold.dim, manifold.dim))
-    steps = FD_REL * reduced_scales(manifold, scale)
-    for j in range(manifold.dim):
-        z = np.zeros(manifold.dim)
-        z[j] = steps[j]
-        ends = []
-        for sign in (1.0, -1.0):
-            r = run(manifold.move(x, sign * z), regime, T)
-            if not r.ok:
-                raise ParameterError(f"the period map failed at a perturbed state: {r.message}")
-            ends.append(r.states[-1, :ly.N_STATE])
-        J[:, j] = manifold.coordinates(ends[0] - ends[1]) / (2 * steps[j])
-    return J
+def stuck_direction(manifold, x) -> np.ndarray | None:
+    """In a regime with a contact at phase 0, the unit vector (reduced coordinates) that moves
+    its first point's tangential position (where friction holds the body); None in free
+    flight."""
+    if manifold.regime == 0:
+        return None
+    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
+    eval_geometry(x[:ly.N_DOF], manifold.P, cg)
+    row = np.zeros(ly.N_DOF)
+    t = ly.CG_T + ly.SET_FIRST[(manifold.regime + 1) // 2]
+    row[ly.S], row[ly.V], row[ly.PSI] = cg[t, ly.CG_DS], cg[t, ly.CG_DV], cg[t, ly.CG_DPSI]
+    along = np.concatenate([manifold.Nq.T @ row, np.zeros(manifold.Nv.shape[1])])
+    return along / max(np.linalg.norm(along), 1e-300)
 
 
 def _floquet(J, manifold, x, scale) -> tuple[np.ndarray, int | None]:
-    """The multipliers, largest modulus first, and the index of the neutral one: in a regime
-    that sticks at phase 0, the multiplier within NEUTRAL_TOL of 1 whose eigenvector (on the
-    error scales) moves mostly the stuck point's tangential position (a family of orbits held
-    by friction at any position)."""
+    """The multipliers, largest modulus first, and the index of the neutral one: with a
+    contact at phase 0, the multiplier within NEUTRAL_TOL of 1 whose eigenvector (on the error
+    scales) moves mostly the body's tangential position (a family of orbits held by friction
+    at any position)."""
     if J is None:
         return np.zeros(0, complex), None
     d = reduced_scales(manifold, scale)
@@ -364,13 +449,10 @@ def _floquet(J, manifold, x, scale) -> tuple[np.ndarray, int | None]:
     vec = vec / d[:, None]
     order = np.argsort(-np.abs(mu), kind="stable")
     mu, vec = mu[order], vec[:, order]
-    if manifold.regime % 2 == 0 or manifold.regime == 0:
+    along = stuck_direction(manifold, x)
+    if along is None:
         return mu, None
-    W = constraint_rows(manifold.P, x[:ly.N_DOF], manifold.regime)
-    along = manifold.Nq.T @ W[-1]
-    along /= max(np.linalg.norm(along), 1e-300)
-    m = manifold.Nq.shape[1]
-    share = np.abs(along @ vec[:m]) / np.linalg.norm(vec, axis=0)
+    share = np.abs(along @ vec) / np.linalg.norm(vec, axis=0)
     candidates = np.flatnonzero((np.abs(mu - 1.0) < NEUTRAL_TOL) & (share > 0.5))
     return mu, (int(candidates[np.argmax(share[candidates])]) if len(candidates) else None)
 
@@ -396,8 +478,14 @@ def _orbit_facts(record, P, periods, T) -> dict:
              & np.isfinite(open_gaps[:-2]) & np.isfinite(open_gaps[2:]))
     minima = open_gaps[1:-1][inner]
     smallest = float(minima.min()) if len(minima) else float("inf")
+    responses = {}
+    for name in ("accel1", "accel2", "accel3", "strain1", "strain2"):
+        x = record.signal(name)
+        responses[f"{name}_amplitude"] = float((x.max() - x.min()) / 2.0)
+        responses[f"{name}_rms"] = float(np.std(x))
     return {"events_per_period": per, "contact_time_share": record.contact_time_share(),
             "tip_amplitude_cm": float((tip.max() - tip.min()) / 2.0),
+            "tip_rms_cm": float(np.std(tip)), "responses": responses,
             "min_open_gap_cm": smallest, "grazing": bool(smallest < GRAZE_REL * P[ly.P_GAP])}
 
 

@@ -1,0 +1,99 @@
+"""Continuation of periodic orbits (model/continuation.py, `workbench continue`)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from workbench import cli
+from workbench.model import drives
+from workbench.model.continuation import Branch, _bifurcation, branch_rows, continue_branch
+from workbench.model.orbit import Orbit, Shooter, periodic_orbit
+from workbench.model.params import Parameters
+from workbench.present.branch import write_branch
+
+
+@pytest.fixture(scope="module")
+def stuck_branch(tmp_path_factory):
+    """0.5 N over 18-22 Hz: the joint stays stuck, a smooth branch of stable orbits."""
+    out = tmp_path_factory.mktemp("branch")
+    p = Parameters()
+    shooter = Shooter(p, drives.sine(0.5, 18.0), parameter="freq_hz")
+    branch = continue_branch(shooter, 18.0, 22.0, on_orbit=lambda b: write_branch(b, out, p))
+    return branch, out
+
+
+def test_a_stuck_branch_is_traced_to_its_end_and_written(stuck_branch):
+    branch, out = stuck_branch
+    assert branch.status == "done" and len(branch.orbits) >= 8, branch.message
+    values = [v for v, _ in branch.orbits]
+    assert values[0] == 18.0 and values[-1] > 22.0 and np.all(np.diff(values) > 0)
+    assert all(o.status == "ok" and o.stable for _, o in branch.orbits)
+    table = pd.read_parquet(out / "branch.parquet")
+    assert len(table) == len(branch.orbits)
+    for column in ("freq_hz", "tip_amplitude_cm", "accel1_amplitude", "strain1_rms",
+                   "max_multiplier", "stable", "bifurcation", "impact_per_period"):
+        assert column in table, column
+    assert (out / "branch.png").exists() and "Status: done" in (out / "report.md").read_text()
+
+
+def test_each_orbit_of_the_branch_is_the_orbit_found_alone(stuck_branch):
+    """An orbit in the middle of the branch, found again by shooting at its frequency alone:
+    the same tip amplitude and multipliers."""
+    branch, _ = stuck_branch
+    value, orbit = branch.orbits[len(branch.orbits) // 2]
+    alone = periodic_orbit(Parameters(), drives.sine(0.5, value))
+    assert alone.status == "ok"
+    assert alone.tip_amplitude_cm == pytest.approx(orbit.tip_amplitude_cm, rel=1e-5)
+    assert np.allclose(np.abs(alone.deciding()), np.abs(orbit.deciding()), atol=1e-5)
+
+
+def _orbit(multipliers, grazing=False) -> Orbit:
+    mu = np.asarray(multipliers, complex)
+    return Orbit("ok", "", 0.05, 1, np.zeros(18), 13, 0.0, 1, mu, bool(np.abs(mu).max() < 1),
+                 grazing, 1.0, {}, {}, 0.0, 0.0, len(mu))
+
+
+@pytest.mark.parametrize("before, after, kind", [
+    ([0.9, 0.5], [1.1, 0.5], "fold"),
+    ([-0.9, 0.5], [-1.1, 0.5], "period doubling"),
+    ([0.6 + 0.7j, 0.6 - 0.7j], [0.7 + 0.8j, 0.7 - 0.8j], "neimark-sacker"),
+    ([-1.1, 0.5], [-0.9, 0.5], "period doubling"),
+    ([0.9, 0.5], [0.95, 0.5], ""),
+])
+def test_a_multiplier_leaving_the_unit_circle_names_the_bifurcation(before, after, kind):
+    assert _bifurcation(_orbit(before), _orbit(after)) == kind
+    assert _bifurcation(_orbit([0.5]), _orbit([0.5], grazing=True)) == "grazing"
+
+
+def test_an_interrupted_continuation_keeps_every_orbit_found(tmp_path):
+    p = Parameters()
+    shooter = Shooter(p, drives.sine(0.5, 20.0), parameter="freq_hz")
+    seen = []
+
+    def write_then_stop(branch):
+        write_branch(branch, tmp_path, p)
+        seen.append(len(branch.orbits))
+        if len(branch.orbits) == 3:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt):
+        continue_branch(shooter, 20.0, 24.0, on_orbit=write_then_stop)
+    assert len(pd.read_parquet(tmp_path / "branch.parquet")) == 3
+    assert branch_rows(Branch("freq_hz")) == []
+
+
+def test_the_continue_command_refuses_what_it_cannot_trace(tmp_path, capsys):
+    assert cli.main(["continue", "--freq-hz", "25:15", "--out", str(tmp_path)]) == 2
+    assert "a range is LO:HI with LO below HI" in capsys.readouterr().err
+    assert cli.main(["continue", "--freq-hz", "20", "--force-n", "10", "--out",
+                     str(tmp_path)]) == 2
+    assert "give one of --freq-hz and --force-n as a range" in capsys.readouterr().err
+    assert cli.main(["continue", "--freq-hz", "15:25", "--force-n", "1:100", "--out",
+                     str(tmp_path)]) == 2
+    capsys.readouterr()
+    assert cli.main(["continue", "--freq-hz", "20:20.5", "--force-n", "0.5", "--out",
+                     str(tmp_path / "b"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "done" and out["orbits"] >= 2 and out["parameter"] == "freq_hz"

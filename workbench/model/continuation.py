@@ -1,0 +1,231 @@
+"""A branch of periodic orbits over the drive's frequency or force, by pseudo-arclength
+continuation (Keller; Seydel, *Practical Bifurcation and Stability Analysis*, 3rd ed., §4.5).
+
+The unknowns are an orbit's reduced coordinates z (:mod:`workbench.model.orbit`: the state
+at phase 0 on its regime's manifold) and the parameter lambda (Hz or N), both on scales
+(the error scales of z, the range of lambda), u = (z / d, lambda / range).  From an orbit u0
+with unit tangent t0 (the null vector of [J - I, dR/dlambda], oriented along the last one,
+the first towards larger lambda), the predictor is u0 + ds t0 and the corrector Newton's
+method on
+
+    R(z, lambda) = Phi(x(z), lambda) - x(z) = 0,    t0 . (u - u0) - ds = 0,
+
+its Jacobian [[J - I, dR/dlambda], [t0]] (J the finite-difference monodromy, dR/dlambda two
+more integrations).  The step ds grows by GROW after a corrector of at most EASY iterations,
+halves after a failed one (a corrector that does not converge in MAX_CORRECTOR iterations,
+a period map that ends in another regime, or a new orbit farther than JUMP x ds from the
+last: a jump to another branch) and the branch ends, with its status, when ds falls below
+DS_MIN, when lambda leaves [lo, hi], or when it folds back past its start.
+
+At each orbit its multipliers are computed; between two orbits a change in the number of
+multipliers outside the unit circle is a bifurcation, named by the multiplier that
+crossed: through +1 a fold (a saddle-node), through -1 a period doubling, as a complex pair
+a Neimark-Sacker; an open gap whose minimum crosses zero, a grazing.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..core import layout as ly
+from .orbit import Orbit, Shooter, reduced_scales, stuck_direction
+from .params import ParameterError
+
+#: Step control (scaled arclength): first step, smallest, largest, growth, easy corrector.
+DS_FIRST = 0.02
+DS_MIN = 1e-4
+DS_MAX = 0.08
+GROW = 1.5
+EASY = 3
+MAX_CORRECTOR = 8
+#: A new orbit farther than JUMP x ds from the last (scaled) is another branch's.
+JUMP = 3.0
+#: A corrector converges at this scaled residual (as a single orbit's).
+CORRECTOR_TOL = 1e-7
+#: The branch ends after this many orbits at most.
+MAX_ORBITS = 200
+
+
+@dataclass
+class Branch:
+    """The orbits of a continuation and how it ended."""
+
+    parameter: str
+    orbits: list = field(default_factory=list)        # (value, Orbit)
+    bifurcations: list = field(default_factory=list)  # (index of the orbit after it, kind)
+    status: str = "running"
+    message: str = ""
+    wall_s: float = 0.0
+
+
+def _bifurcation(before: Orbit, after: Orbit) -> str:
+    """The kind of a change of stability between two orbits (module docstring), or ''."""
+    if before.grazing != after.grazing:
+        return "grazing"
+    a, b = before.deciding(), after.deciding()
+    n_a, n_b = int((np.abs(a) > 1.0).sum()), int((np.abs(b) > 1.0).sum())
+    if n_a == n_b:
+        return ""
+    outside = b if n_b > n_a else a                   # the side with the multiplier out
+    crossed = outside[np.argmax(np.abs(outside))]
+    if abs(crossed.imag) > 1e-6 * abs(crossed):
+        return "neimark-sacker"
+    return "fold" if crossed.real > 0 else "period doubling"
+
+
+def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable | None = None,
+                    ds: float = DS_FIRST, start: Orbit | None = None) -> Branch:
+    """Trace the branch of ``shooter``'s orbits from its parameter ``lo`` towards ``hi``
+    (module docstring); ``on_orbit(branch)`` is called after each orbit (to write it out).
+    ``start``: an orbit at ``lo`` (default: found from the state after a run)."""
+    from .orbit import periodic_orbit
+    t0 = time.perf_counter()
+    if not lo < hi:
+        raise ParameterError(f"the range {lo:g}:{hi:g} must be increasing")
+    branch = Branch(shooter.parameter)
+    span = hi - lo
+    if start is None:
+        start = periodic_orbit(shooter.params, shooter.drive_at(lo), shooter.periods,
+                               fixed=shooter.fixed)
+    if start.status not in ("ok", "grazing"):
+        branch.status, branch.message = "no start", f"no orbit at {lo:g}: {start.message}"
+        return _done(branch, t0)
+    value, orbit = lo, start
+    branch.orbits.append((value, orbit))
+    tangent = None
+    while len(branch.orbits) < MAX_ORBITS:
+        if on_orbit:
+            on_orbit(branch)
+        manifold = shooter.manifold(orbit.state, orbit.regime)
+        ex = shooter.drive_at(value)
+        record, res, scale, _, _ = shooter.residual(orbit.state, orbit.regime, ex)
+        d = np.concatenate([reduced_scales(manifold, scale), [span]])
+        J = orbit.monodromy if orbit.monodromy is not None and \
+            orbit.monodromy.shape[0] == manifold.dim else \
+            shooter.monodromy(manifold, orbit.state, orbit.regime, ex, scale)
+        dR = shooter.d_parameter(manifold, orbit.state, orbit.regime, value)
+        pin = _pin(orbit, manifold, d)
+        tangent = _tangent(J, dR, d, manifold, tangent, pin)
+        accepted = None
+        while accepted is None:
+            if ds < DS_MIN:
+                branch.status, branch.message = "step floor", (
+                    f"the step fell below {DS_MIN:g} at {value:.6g}: a turning point the "
+                    "corrector cannot pass, a grazing or the end of a regime at phase 0")
+                return _done(branch, t0)
+            accepted = _correct(shooter, orbit, value, manifold, d, tangent, ds, pin)
+            if accepted is None:
+                ds /= 2.0
+        new_value, new_orbit, iterations = accepted
+        kind = _bifurcation(orbit, new_orbit)
+        if kind:
+            branch.bifurcations.append((len(branch.orbits), kind))
+        branch.orbits.append((new_value, new_orbit))
+        if iterations <= EASY:
+            ds = min(DS_MAX, ds * GROW)
+        if new_value > hi:
+            branch.status, branch.message = "done", f"reached {hi:g}"
+            return _done(branch, t0, on_orbit)
+        if new_value < lo - 1e-9 * span:
+            branch.status, branch.message = "folded back", (
+                f"the branch turned back past its start {lo:g} (at {new_value:.6g})")
+            return _done(branch, t0, on_orbit)
+        value, orbit = new_value, new_orbit
+    branch.status, branch.message = "max orbits", f"{MAX_ORBITS} orbits"
+    return _done(branch, t0, on_orbit)
+
+
+def _done(branch: Branch, t0: float, on_orbit=None) -> Branch:
+    branch.wall_s = time.perf_counter() - t0
+    if on_orbit:
+        on_orbit(branch)
+    return branch
+
+
+def _pin(orbit, manifold, d) -> np.ndarray | None:
+    """The row (scaled unknowns) that holds a stuck position where friction holds the orbit at
+    any (its neutral multiplier): a phase-like condition that makes the branch unique."""
+    if orbit.neutral is None:
+        return None
+    along = stuck_direction(manifold, orbit.state)
+    row = np.concatenate([along * d[:manifold.dim], [0.0]])
+    return row / np.linalg.norm(row)
+
+
+def _tangent(J, dR, d, manifold, previous, pin=None) -> np.ndarray:
+    """The unit tangent (scaled) of the branch: the null vector of [J - I, dR] on the scales
+    (and of the pin, :func:`_pin`), oriented along ``previous`` (else towards larger
+    lambda)."""
+    n = manifold.dim
+    A = np.hstack([(J - np.eye(n)) * d[:n][None, :], (dR * d[n])[:, None]]) / d[:n][:, None]
+    if pin is not None:
+        A = np.vstack([A, pin])
+    _, _, vt = np.linalg.svd(A)
+    t = vt[-1]
+    t /= np.linalg.norm(t)
+    if previous is not None and len(previous) == len(t):
+        return t if t @ previous >= 0 else -t
+    return t if t[-1] >= 0 else -t
+
+
+def _correct(shooter, orbit, value, manifold, d, tangent, ds, pin=None):
+    """Newton on the augmented system from the predictor; (value, Orbit, iterations) or None."""
+    n = manifold.dim
+    x0 = orbit.state
+    u = ds * tangent                                   # scaled offset from the last orbit
+    t_wall = time.perf_counter()
+    history = []
+    try:
+        for it in range(1, MAX_CORRECTOR + 1):
+            lam = value + u[n] * d[n]
+            ex = shooter.drive_at(lam)
+            x = manifold.project(manifold.move(x0, u[:n] * d[:n]))
+            record, res, scale, residual, end_regime = shooter.residual(x, orbit.regime, ex)
+            history.append(residual)
+            if end_regime != orbit.regime:
+                return None
+            J = shooter.monodromy(manifold, x, orbit.regime, ex, scale)
+            if residual <= CORRECTOR_TOL:
+                if np.linalg.norm(u) > JUMP * ds:
+                    return None
+                found = shooter.orbit(x, orbit.regime, ex, record, J, history, it, "ok",
+                                      "found", t_wall)
+                return lam, found, it
+            dR = shooter.d_parameter(manifold, x, orbit.regime, lam)
+            F = np.concatenate([manifold.coordinates(res) / d[:n], [tangent @ u - ds]])
+            A = np.zeros((n + 1, n + 1))
+            A[:n, :n] = (J - np.eye(n)) * d[:n][None, :] / d[:n][:, None]
+            A[:n, n] = dR * d[n] / d[:n]
+            A[n] = tangent
+            if pin is not None:
+                A, F = np.vstack([A, pin]), np.concatenate([F, [pin @ u]])
+            u = u - np.linalg.lstsq(A, F, rcond=None)[0]
+    except ParameterError:
+        return None
+    return None
+
+
+def branch_rows(branch: Branch) -> list[dict]:
+    """One row per orbit (CGS like the points table): the parameter, the orbit's responses,
+    contact shares, events per period, the largest multiplier's modulus, ``stable`` and the
+    ``bifurcation`` between it and the one before."""
+    kinds = dict(branch.bifurcations)
+    rows = []
+    for i, (value, orbit) in enumerate(branch.orbits):
+        deciding = orbit.deciding()
+        row = {branch.parameter: value, "status": orbit.status, "periods": orbit.periods,
+               "tip_amplitude_cm": orbit.tip_amplitude_cm, "tip_rms_cm": orbit.tip_rms_cm,
+               **orbit.responses,
+               **{f"share_{k}": v for k, v in orbit.contact_time_share.items()},
+               **{f"{k.replace('-', '_')}_per_period": v
+                  for k, v in orbit.events_per_period.items()},
+               "max_multiplier": float(np.abs(deciding).max(initial=0.0)),
+               "stable": bool(orbit.stable), "grazing": orbit.grazing,
+               "contact_code_at_phase0": int(ly.CONTACT_CODE[(orbit.regime + 1) // 2]),
+               "bifurcation": kinds.get(i, ""), "newton_iterations": orbit.newton_iterations,
+               "residual": orbit.residual}
+        rows.append(row)
+    return rows
