@@ -29,7 +29,7 @@ def test_the_stuck_joints_orbit_has_the_locked_models_multipliers():
     orbit = periodic_orbit(p, drives.sine(0.5, 20.0))
     assert orbit.status == "ok" and orbit.residual <= 1e-7, orbit.message
     assert orbit.dimension == 13 and sum(orbit.events_per_period.values()) == 0
-    assert abs(orbit.neutral - 1.0) < 1e-6 and orbit.stable
+    assert abs(orbit.neutral - 1.0) < 1e-6 and orbit.stable and orbit.multiplier_error < 2e-4
     lam = np.linalg.eigvals(_state_matrix(p, "locked", "static", orbit.state[:ly.N_DOF]))
     expected = np.exp(lam / 20.0)
     mu = orbit.deciding()
@@ -50,11 +50,13 @@ def stick_slip_orbit():
 
 def test_a_stick_slip_orbit_is_found_and_a_run_from_near_it_stays_on_it(stick_slip_orbit):
     """Newton from a 30-period run converges; a run of 60 periods started 1e-6 of the error
-    scales off the orbit ends on it within 1e-5 of the scales (its multipliers, the stuck
-    position's left out, are inside the unit circle), and its every period passes through
-    the same events."""
+    scales off the orbit ends on it within 1e-5 of the scales, and its every period passes
+    through the same events.  Its slowest multiplier (0.99936, the 2 Hz bending mode) lies
+    within the finite differences' error (about 1e-3 through 30 events a period) of the unit
+    circle: the orbit says its stability is undetermined rather than guess."""
     orbit = stick_slip_orbit
-    assert orbit.status == "ok" and orbit.stable, orbit.to_dict()
+    assert orbit.status == "ok" and orbit.stable is None, orbit.to_dict()
+    assert "stability undetermined" in orbit.message and 1e-5 < orbit.multiplier_error < 1e-2
     assert orbit.events_per_period["impact"] == 2 and orbit.events_per_period["stick-slip"] > 10
     assert abs(orbit.deciding()).max() < 1.0 and orbit.neutral is not None
     p, f = Parameters(), 30.0

@@ -17,10 +17,12 @@ a period map that ends in another regime, or a new orbit farther than JUMP x ds 
 last: a jump to another branch) and the branch ends, with its status, when ds falls below
 DS_MIN, when lambda leaves [lo, hi], or when it folds back past its start.
 
-At each orbit its multipliers are computed; between two orbits a change in the number of
-multipliers outside the unit circle is a bifurcation, named by the multiplier that
-crossed: through +1 a fold (a saddle-node), through -1 a period doubling, as a complex pair
-a Neimark-Sacker; an open gap whose minimum crosses zero, a grazing.
+At each orbit its multipliers are computed; between two orbits whose stability they decide
+(beyond their error estimate, :mod:`workbench.model.orbit`; orbits between them whose
+stability is undetermined are skipped) a change in the number of multipliers outside the
+unit circle is a bifurcation, named by the multiplier that crossed: through +1 a fold (a
+saddle-node), through -1 a period doubling, as a complex pair a Neimark-Sacker; an open gap
+whose minimum starts or stops touching zero, a grazing.
 """
 from __future__ import annotations
 
@@ -94,6 +96,7 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         branch.status, branch.message = "no start", f"no orbit at {lo:g}: {start.message}"
         return _done(branch, t0)
     value, orbit = lo, start
+    determined = start               # the last orbit whose stability the multipliers decide
     branch.orbits.append((value, orbit))
     tangent = None
     while len(branch.orbits) < MAX_ORBITS:
@@ -120,9 +123,12 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
             if accepted is None:
                 ds /= 2.0
         new_value, new_orbit, iterations = accepted
-        kind = _bifurcation(orbit, new_orbit)
+        kind = ("grazing" if new_orbit.grazing != orbit.grazing else
+                _bifurcation(determined, new_orbit) if new_orbit.stable is not None else "")
         if kind:
             branch.bifurcations.append((len(branch.orbits), kind))
+        if new_orbit.stable is not None:
+            determined = new_orbit
         branch.orbits.append((new_value, new_orbit))
         if iterations <= EASY:
             ds = min(DS_MAX, ds * GROW)
@@ -223,7 +229,11 @@ def branch_rows(branch: Branch) -> list[dict]:
                **{f"{k.replace('-', '_')}_per_period": v
                   for k, v in orbit.events_per_period.items()},
                "max_multiplier": float(np.abs(deciding).max(initial=0.0)),
-               "stable": bool(orbit.stable), "grazing": orbit.grazing,
+               "multiplier_error": orbit.multiplier_error,
+               "stable": orbit.stable is True,
+               "stability": {True: "stable", False: "unstable", None: "undetermined"}[
+                   orbit.stable],
+               "grazing": orbit.grazing,
                "contact_code_at_phase0": int(ly.CONTACT_CODE[(orbit.regime + 1) // 2]),
                "bifurcation": kinds.get(i, ""), "newton_iterations": orbit.newton_iterations,
                "residual": orbit.residual}

@@ -19,7 +19,11 @@ correction keeps W(q) q' = 0 to first order).  Free flight: 18 coordinates; the 
 differences of the map, 2 x dim integrations of K periods per Newton step (through every
 event of the orbit: away from grazing the map is smooth there).  Its eigenvalues are the
 Floquet multipliers (the reduced system's; the constrained directions have none); the
-orbit is stable when every |multiplier| < 1 (STABLE_MARGIN) but the neutral one: where
+multipliers' error is estimated by the monodromy again with a step CHECK_STEP times larger
+(``multiplier_error``, the largest shift of a multiplier); the orbit is stable when every
+|multiplier| is below 1 by more than that, unstable when one is above 1 by more, and its
+stability undetermined (``stable`` null, the message says so) in between; all but the
+neutral one: where
 friction holds the loose body, the orbit is one of a family (held at any position in the
 cone: shifted along the slide it is still an orbit, the cork's pull aside), with a multiplier
 1 along the body's tangential position, reported as ``neutral_multiplier`` and left out of
@@ -60,7 +64,9 @@ MAX_NEWTON = 15
 FD_REL = 1e-6
 #: The integrator's tolerance for the period map (tighter than the Newton tolerance by 100).
 MAP_TOL = 1e-9
-#: |multiplier| below 1 - STABLE_MARGIN is stable (the monodromy's own error is ~1e-6).
+#: The monodromy again with CHECK_STEP times the step: the multipliers' error estimate.
+CHECK_STEP = 10.0
+#: |multiplier| below 1 - max(STABLE_MARGIN, its error) is stable, above 1 + that unstable.
 STABLE_MARGIN = 1e-6
 #: A multiplier this close to 1 moving the body's tangential position is the friction-held
 #: family's (measured: 1 - 1e-9 on the stuck joint, 1 + 4e-4 with 15 stick-slip cycles a
@@ -99,6 +105,7 @@ class Orbit:
     responses: dict = field(default_factory=dict)   # amplitude and RMS of accel1-3 (cm/s²) and
                                                     # strain1-2 over the orbit
     tip_rms_cm: float = float("nan")
+    multiplier_error: float = float("nan")   # the multipliers' error estimate (module docstring)
 
     def deciding(self) -> np.ndarray:
         """The multipliers that decide the stability: all but the neutral one."""
@@ -113,7 +120,8 @@ class Orbit:
                 "periods": self.periods, "residual": self.residual,
                 "newton_iterations": self.newton_iterations,
                 "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
-                "stable": self.stable, "grazing": self.grazing,
+                "stable": self.stable, "multiplier_error": self.multiplier_error,
+                "grazing": self.grazing,
                 "min_open_gap_cm": self.min_open_gap_cm,
                 "events_per_period": self.events_per_period,
                 "contact_time_share": self.contact_time_share,
@@ -314,10 +322,11 @@ class Shooter:
         return (record, res, scale, float(np.max(np.abs(res) / scale)),
                 int(record.signal("regime")[-1]))
 
-    def monodromy(self, manifold, x, regime, ex, scale) -> np.ndarray:
-        """The K-period map's Jacobian in the reduced coordinates, by central differences."""
+    def monodromy(self, manifold, x, regime, ex, scale, rel: float = FD_REL) -> np.ndarray:
+        """The K-period map's Jacobian in the reduced coordinates, by central differences of
+        ``rel`` of the error scales."""
         J = np.empty((manifold.dim, manifold.dim))
-        steps = FD_REL * reduced_scales(manifold, scale)
+        steps = rel * reduced_scales(manifold, scale)
         for j in range(manifold.dim):
             z = np.zeros(manifold.dim)
             z[j] = steps[j]
@@ -348,15 +357,35 @@ class Shooter:
         if status == "ok" and facts["grazing"]:
             status, message = "grazing", ("found, but an open gap grazes zero: the multipliers "
                                           "are not defined there")
-        others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
-        stable = bool(others.max(initial=0.0) < 1.0 - STABLE_MARGIN) if status == "ok" else None
+        error = np.nan
+        stable = None
+        if status == "ok":
+            scale = error_scales(self.P, record.states)
+            coarse = self.monodromy(manifold, x, regime, ex, scale, CHECK_STEP * FD_REL)
+            error = multiplier_error(J, coarse)
+            others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
+            largest = others.max(initial=0.0)
+            if largest < 1.0 - max(error, STABLE_MARGIN):
+                stable = True
+            elif largest > 1.0 + max(error, STABLE_MARGIN):
+                stable = False
+            else:
+                message = (f"found; stability undetermined: the largest |multiplier| "
+                           f"{largest:.6f} is within the monodromy's error {error:.1e} of 1")
         return Orbit(status, message, T, self.periods, x, regime,
                      history[-1] if history else np.inf, iterations, multipliers, stable,
                      facts["grazing"], facts["min_open_gap_cm"], facts["events_per_period"],
                      facts["contact_time_share"], facts["tip_amplitude_cm"],
                      time.perf_counter() - t_wall, manifold.dim, history,
                      None if neutral is None else complex(multipliers[neutral]), J,
-                     facts["responses"], facts["tip_rms_cm"])
+                     facts["responses"], facts["tip_rms_cm"], error)
+
+
+def multiplier_error(J: np.ndarray, other: np.ndarray) -> float:
+    """The largest distance from a multiplier of J to the nearest of ``other`` (the same
+    monodromy by another finite-difference step): the multipliers' error estimate."""
+    a, b = np.linalg.eigvals(J), np.linalg.eigvals(other)
+    return float(max((np.abs(b - m).min() for m in a), default=0.0))
 
 
 def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,

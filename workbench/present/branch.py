@@ -22,8 +22,8 @@ MARKERS = {"fold": "s", "period doubling": "D", "neimark-sacker": "^", "grazing"
 
 
 def branch_figure(table: pd.DataFrame, parameter: str, title: str):
-    """The tip's amplitude (mm) along the branch: stable orbits solid, unstable dashed, each
-    bifurcation marked at the orbit after it."""
+    """The tip's amplitude (mm) along the branch: stable orbits solid, unstable (or of
+    undetermined stability) dashed, each bifurcation marked at the orbit after it."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7.0, 4.2), layout="constrained")
     unit, factor = units.channel("tip")
@@ -34,7 +34,12 @@ def branch_figure(table: pd.DataFrame, parameter: str, title: str):
         ax.plot(x[i:i + 2], y[i:i + 2], "-" if both else "--", color="C0" if both else "C3",
                 lw=1.4)
     ax.plot(x[stable], y[stable], "o", color="C0", ms=3, label="stable")
-    ax.plot(x[~stable], y[~stable], "o", mfc="none", color="C3", ms=4, label="unstable")
+    word = table.stability.to_numpy()
+    ax.plot(x[word == "unstable"], y[word == "unstable"], "o", mfc="none", color="C3", ms=4,
+            label="unstable")
+    if (word == "undetermined").any():
+        ax.plot(x[word == "undetermined"], y[word == "undetermined"], "o", mfc="none",
+                color="0.5", ms=4, label="undetermined (|μ| within its error of 1)")
     for kind, marker in MARKERS.items():
         at = table.bifurcation == kind
         if at.any():
@@ -63,7 +68,10 @@ def write_branch(branch: Branch, out: Path, params) -> None:
     stable = table.stable.to_numpy(bool) if len(table) else np.zeros(0, bool)
     lines = [f"# A branch of periodic orbits", "", title + ".", "",
              f"Status: {branch.status} ({branch.message}); {len(table)} orbits, "
-             f"{int(stable.sum())} stable, in {branch.wall_s:.0f} s (pseudo-arclength "
+             f"{int(stable.sum())} stable, "
+             f"{int((table.stability == 'undetermined').sum()) if len(table) else 0} of "
+             f"stability undetermined (a multiplier within its error of 1), in "
+             f"{branch.wall_s:.0f} s (pseudo-arclength "
              "continuation, `workbench/model/continuation.py`; multipliers from the "
              "finite-difference monodromy).", ""]
     if branch.bifurcations:
