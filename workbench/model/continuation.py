@@ -13,8 +13,11 @@ method on
 its Jacobian [[J - I, dR/dlambda], [t0]] (J the finite-difference monodromy, dR/dlambda two
 more integrations).  The step ds grows by GROW after a corrector of at most EASY iterations,
 halves after a failed one (a corrector that does not converge in MAX_CORRECTOR iterations,
-a period map that ends in another regime, or a new orbit farther than JUMP x ds from the
-last: a jump to another branch) and the branch ends, with its status, when ds falls below
+or a new orbit farther than JUMP x ds from the last: a jump to another branch).  Where the
+orbit's state at phase 0 passes an event along the branch (the period map ends in another
+regime than it starts from), the orbit at the predicted parameter is found by shooting
+from the predicted state in the regime it reaches, and taken if it lies within JUMP x ds of
+the last (on the error scales).  The branch ends, with its status, when ds falls below
 DS_MIN, when lambda leaves [lo, hi], or when it folds back past its start.
 
 At each orbit its multipliers are computed; between two orbits whose stability they decide
@@ -33,7 +36,7 @@ from typing import Callable
 import numpy as np
 
 from ..core import layout as ly
-from .orbit import Orbit, Shooter, reduced_scales, stuck_direction
+from .orbit import Orbit, Shooter, error_scales, reduced_scales, stuck_direction
 from .params import ParameterError
 
 #: Step control (scaled arclength): first step, smallest, largest, growth, easy corrector.
@@ -120,6 +123,8 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
                     "corrector cannot pass, a grazing or the end of a regime at phase 0")
                 return _done(branch, t0)
             accepted = _correct(shooter, orbit, value, manifold, d, tangent, ds, pin)
+            if accepted is None:
+                accepted = _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds)
             if accepted is None:
                 ds /= 2.0
         new_value, new_orbit, iterations = accepted
@@ -212,6 +217,28 @@ def _correct(shooter, orbit, value, manifold, d, tangent, ds, pin=None):
     except ParameterError:
         return None
     return None
+
+
+def _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds):
+    """Where the orbit's state at phase 0 passes an event (the period map ends in another
+    regime than it starts from), the corrector's manifold is the wrong one: the orbit at the
+    predictor's parameter, found by shooting from the predicted state (which runs on a period
+    into the regime it reaches), if it lies within JUMP x ds of the last; else None."""
+    from .orbit import periodic_orbit
+    n = manifold.dim
+    u = ds * tangent
+    lam = value + u[n] * d[n]
+    x = manifold.project(manifold.move(orbit.state, u[:n] * d[:n]))
+    found = periodic_orbit(shooter.params, shooter.drive_at(lam), shooter.periods,
+                           guess=(x, orbit.regime), max_newton=MAX_CORRECTOR,
+                           newton_tol=CORRECTOR_TOL, fixed=shooter.fixed)
+    if found.status not in ("ok", "grazing") or found.regime == orbit.regime:
+        return None
+    scale = error_scales(shooter.P, shooter.run(orbit.state, orbit.regime,
+                                                shooter.drive_at(value)).states)
+    if np.max(np.abs(found.state - orbit.state) / scale) > JUMP * ds:
+        return None
+    return lam, found, found.newton_iterations
 
 
 def branch_rows(branch: Branch) -> list[dict]:
