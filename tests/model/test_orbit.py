@@ -89,6 +89,16 @@ def test_the_orbit_command_prints_the_json_the_issue_names(capsys):
     assert moduli == sorted(moduli, reverse=True)
 
 
+def test_a_search_that_does_not_converge_says_so_and_reports_no_orbit():
+    """One Newton step allowed from the rocking 200 N, 20 Hz state: the status says no fixed
+    point was found, with the residual reached, and no stability is reported for the
+    iterate."""
+    orbit = periodic_orbit(Parameters(), drives.sine(200.0, 20.0), max_newton=1,
+                           newton_tol=1e-30)
+    assert orbit.status == "not converged" and orbit.stable is None
+    assert np.isfinite(orbit.residual) and orbit.residual > 0
+
+
 def test_bad_input_is_refused_in_one_line(capsys):
     with pytest.raises(ParameterError, match="periods = 0: a whole number of drive periods"):
         periodic_orbit(Parameters(), drives.sine(1.0, 20.0), periods=0)

@@ -352,6 +352,8 @@ class Shooter:
         facts of its record."""
         T = self.period_s(ex)
         manifold = self.manifold(x, regime)
+        if J is not None and J.shape[0] != manifold.dim:     # another regime's, at no orbit
+            J = None
         multipliers, neutral = _floquet(J, manifold, x, error_scales(self.P, record.states))
         facts = _orbit_facts(record, self.P, self.periods, T)
         if status == "ok" and facts["grazing"]:
