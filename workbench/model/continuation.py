@@ -97,7 +97,8 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
                                fixed=shooter.fixed)
     if start.status not in ("ok", "grazing"):
         branch.status, branch.message = "no start", f"no orbit at {lo:g}: {start.message}"
-        return _done(branch, t0)
+        return _done(branch, t0, on_orbit)
+    shooter.phase = start.phase
     value, orbit = lo, start
     determined = start               # the last orbit whose stability the multipliers decide
     branch.orbits.append((value, orbit))
@@ -231,7 +232,8 @@ def _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds):
     x = manifold.project(manifold.move(orbit.state, u[:n] * d[:n]))
     found = periodic_orbit(shooter.params, shooter.drive_at(lam), shooter.periods,
                            guess=(x, orbit.regime), max_newton=MAX_CORRECTOR,
-                           newton_tol=CORRECTOR_TOL, fixed=shooter.fixed)
+                           newton_tol=CORRECTOR_TOL, fixed=shooter.fixed,
+                           phases=(shooter.phase,))
     if found.status not in ("ok", "grazing") or found.regime == orbit.regime:
         return None
     scale = error_scales(shooter.P, shooter.run(orbit.state, orbit.regime,

@@ -1,8 +1,9 @@
 """Periodic responses of the sine-driven model by shooting, and their Floquet multipliers.
 
 A periodic orbit of K drive periods T = K / f is a fixed point of the K-period map: the
-state x = (q, q') at drive phase 0 and its regime (contact set, stick or slip) such that
-integrating K periods from x returns to x.  :func:`periodic_orbit` solves Phi(x) = x by
+state x = (q, q') at a drive phase (the section, 0 unless the state there is near an event:
+then the next of PHASES) and its regime (contact set, stick or slip) such that integrating K
+periods from x returns to x.  :func:`periodic_orbit` solves Phi(x) = x by
 Newton's method from a guess (by default the state after GUESS_PERIODS drive periods from the
 static equilibrium, the drive's soft start over the first RAMP_PERIODS).
 
@@ -31,7 +32,8 @@ the stability (NEUTRAL_TOL).
 
 **Residual.**  |Phi(x) - x| on the integrator's error scales (``core.error_scales``: each
 component's largest |value| over the orbit, its partner's, or the floor from the gap) —
-the orbit is found when the largest is at most ``newton_tol``.
+the orbit is found when the largest is at most ``newton_tol``; a Newton step that makes it
+grow, or leaves the regime, is halved (BACKTRACK times at most).
 
 **Grazing.**  An orbit on which an open point's gap has a minimum in time within GRAZE_REL
 of the clearance of zero (it touches without closing) is flagged: its multipliers are not defined there (the map is not
@@ -59,6 +61,11 @@ from .regimes import contact_code
 #: The guess: drive periods from the static equilibrium, the first RAMP_PERIODS a soft start.
 GUESS_PERIODS = 30
 RAMP_PERIODS = 5
+#: The drive phases (fractions of a period) a section is tried at, in order: where the state
+#: at one is near an event (the map ends in another regime), the next.
+PHASES = (0.0, 0.25, 0.5, 0.75)
+#: Newton's step is halved at most this many times while the residual grows.
+BACKTRACK = 4
 #: Newton: iterations at most, and the relative finite-difference step on the error scales.
 MAX_NEWTON = 15
 FD_REL = 1e-6
@@ -86,7 +93,7 @@ class Orbit:
     message: str
     period_s: float
     periods: int
-    state: np.ndarray                 # (q, q') at phase 0, (18,)
+    state: np.ndarray                 # (q, q') at the section's phase, (18,)
     regime: int
     residual: float
     newton_iterations: int
@@ -106,6 +113,7 @@ class Orbit:
                                                     # strain1-2 over the orbit
     tip_rms_cm: float = float("nan")
     multiplier_error: float = float("nan")   # the multipliers' error estimate (module docstring)
+    phase: float = 0.0                # the section's drive phase (fraction of a period)
 
     def deciding(self) -> np.ndarray:
         """The multipliers that decide the stability: all but the neutral one."""
@@ -126,6 +134,7 @@ class Orbit:
                 "events_per_period": self.events_per_period,
                 "contact_time_share": self.contact_time_share,
                 "tip_amplitude_cm": self.tip_amplitude_cm, "tip_rms_cm": self.tip_rms_cm,
+                "phase": self.phase,
                 **self.responses, "wall_s": self.wall_s,
                 "regime": self.regime, "contact_code": int(contact_code(self.regime)),
                 "dimension": self.dimension, "monodromy": "finite-difference",
@@ -268,6 +277,11 @@ class Shooter:
         self.ex, _ = sine_of(drive)
         model = mdl.build(params, fixed=fixed)
         self.P, self.free = model.P, np.array(model.free)
+        self.phase = 0.0          # the section's drive phase, a fraction of a period
+
+    def t0(self, ex) -> float:
+        """The section's time (s): its phase of the drive period."""
+        return self.phase / float(ex[cx.X_FREQ])
 
     def value(self, ex=None) -> float:
         """The parameter's value (Hz or N) of an excitation array (default the drive's)."""
@@ -293,7 +307,8 @@ class Shooter:
         f = float(ex[cx.X_FREQ])
         dt, rate = lattice(self.params, ex, 1.0 / f)
         return simulate(self.params, ex, (periods or self.periods) / f, initial=x[:ly.N_STATE],
-                        regime=regime, tol=MAP_TOL, dt=dt, output_hz=rate, fixed=self.fixed)
+                        regime=regime, tol=MAP_TOL, dt=dt, output_hz=rate, fixed=self.fixed,
+                        t0=self.t0(ex))
 
     def guess(self, ex) -> tuple[np.ndarray, int]:
         """The state and regime after GUESS_PERIODS periods from the static equilibrium, the
@@ -303,8 +318,8 @@ class Shooter:
         ramped = ex.copy()
         ramped[cx.X_RAMP] = RAMP_PERIODS / f
         dt, rate = lattice(self.params, ex, 1.0 / f)
-        start = simulate(self.params, ramped, GUESS_PERIODS / f, tol=MAP_TOL, dt=dt,
-                         output_hz=rate, fixed=self.fixed)
+        start = simulate(self.params, ramped, GUESS_PERIODS / f + self.t0(ex), tol=MAP_TOL,
+                         dt=dt, output_hz=rate, fixed=self.fixed)
         if not start.ok:
             raise ParameterError(f"the guess run failed: {start.message}")
         return start.states[-1, :ly.N_STATE].copy(), int(start.signal("regime")[-1])
@@ -346,6 +361,49 @@ class Shooter:
             raise ParameterError(f"the period map failed at a perturbed state: {r.message}")
         return r.states[-1, :ly.N_STATE]
 
+    def find(self, guess, newton_tol, max_newton, t_wall) -> "Orbit":
+        """Newton's method on the map at the section's phase (module docstring)."""
+        ex = self.ex
+        try:
+            x, regime = self.guess(ex) if guess is None else (
+                np.array(guess[0], float)[:ly.N_STATE].copy(), int(guess[1]))
+        except ParameterError as exc:
+            return _failed(str(exc), self.period_s(ex), self.periods, t_wall)
+        history, status, message = [], "not converged", f"no fixed point in {max_newton} steps"
+        iterations, J, record = 0, None, None
+        try:
+            for iterations in range(1, max_newton + 1):
+                manifold = self.manifold(x, regime)
+                x = manifold.project(x)
+                record, res, scale, residual, end_regime = self.residual(x, regime, ex)
+                history.append(residual)
+                if end_regime != regime:
+                    message = (f"the period map ends in regime {end_regime}, not {regime}: the "
+                               "iterate is not near an orbit of this regime")
+                    x, regime = record.states[-1, :ly.N_STATE].copy(), end_regime  # on a period
+                    continue
+                J = self.monodromy(manifold, x, regime, ex, scale)
+                if residual <= newton_tol:
+                    status, message = "ok", "found"
+                    break
+                step = np.linalg.lstsq(J - np.eye(manifold.dim), -manifold.coordinates(res),
+                                       rcond=None)[0]
+                x = self._damped(manifold, x, regime, ex, step, residual)
+        except ParameterError as exc:
+            return _failed(str(exc), self.period_s(ex), self.periods, t_wall)
+        return self.orbit(x, regime, ex, record, J, history, iterations, status, message, t_wall)
+
+    def _damped(self, manifold, x, regime, ex, step, residual):
+        """x moved by the Newton step, halved (at most BACKTRACK times) while the residual
+        grows or the map leaves the regime: Newton's method damped."""
+        for _ in range(BACKTRACK):
+            trial = manifold.project(manifold.move(x, step))
+            _, _, _, new, end = self.residual(trial, regime, ex)
+            if end == regime and new < residual:
+                return trial
+            step = step / 2.0
+        return manifold.project(manifold.move(x, step))
+
     def orbit(self, x, regime, ex, record, J, history, iterations, status, message,
               t_wall) -> "Orbit":
         """The :class:`Orbit` at a solution (or the last iterate) with its multipliers and the
@@ -374,13 +432,14 @@ class Shooter:
             else:
                 message = (f"found; stability undetermined: the largest |multiplier| "
                            f"{largest:.6f} is within the monodromy's error {error:.1e} of 1")
+        message += f" (section at phase {self.phase:g} of the drive period)" if self.phase else ""
         return Orbit(status, message, T, self.periods, x, regime,
                      history[-1] if history else np.inf, iterations, multipliers, stable,
                      facts["grazing"], facts["min_open_gap_cm"], facts["events_per_period"],
                      facts["contact_time_share"], facts["tip_amplitude_cm"],
                      time.perf_counter() - t_wall, manifold.dim, history,
                      None if neutral is None else complex(multipliers[neutral]), J,
-                     facts["responses"], facts["tip_rms_cm"], error)
+                     facts["responses"], facts["tip_rms_cm"], error, self.phase)
 
 
 def multiplier_error(J: np.ndarray, other: np.ndarray) -> float:
@@ -392,45 +451,25 @@ def multiplier_error(J: np.ndarray, other: np.ndarray) -> float:
 
 def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
                    newton_tol: float = 1e-7, max_newton: int = MAX_NEWTON,
-                   fixed=()) -> Orbit:
+                   fixed=(), phases=PHASES) -> Orbit:
     """A periodic orbit of ``periods`` drive periods (module docstring).
 
     ``drive``: a sine (``drives.sine(force_n, freq_hz)`` or its settings; the soft start is
-    dropped).  ``guess``: (state (18,), regime) to start Newton from; by default the state
-    after GUESS_PERIODS periods from the static equilibrium.  Returns an :class:`Orbit`
-    whose ``status`` says whether it was found; never one it did not find.
+    dropped).  ``guess``: (state (18,), regime) at the first phase to start Newton from; by
+    default the state after GUESS_PERIODS periods from the static equilibrium.  The section
+    is taken at the drive phases ``phases`` in turn (fractions of a period) until one gives
+    an orbit.  Returns an :class:`Orbit` whose ``status`` says whether it was found; never
+    one it did not find.
     """
     t_wall = time.perf_counter()
     shooter = Shooter(params, drive, periods, fixed)
-    ex = shooter.ex
-    try:
-        x, regime = shooter.guess(ex) if guess is None else (
-            np.array(guess[0], float)[:ly.N_STATE].copy(), int(guess[1]))
-    except ParameterError as exc:
-        return _failed(str(exc), shooter.period_s(ex), periods, t_wall)
-    history, status, message = [], "not converged", f"no fixed point in {max_newton} steps"
-    iterations, J, record = 0, None, None
-    try:
-        for iterations in range(1, max_newton + 1):
-            manifold = shooter.manifold(x, regime)
-            x = manifold.project(x)
-            record, res, scale, residual, end_regime = shooter.residual(x, regime, ex)
-            history.append(residual)
-            if end_regime != regime:
-                message = (f"the period map ends in regime {end_regime}, not {regime}: the "
-                           "iterate is not near an orbit of this regime")
-                x, regime = record.states[-1, :ly.N_STATE].copy(), end_regime   # one period on
-                continue
-            J = shooter.monodromy(manifold, x, regime, ex, scale)
-            if residual <= newton_tol:
-                status, message = "ok", "found"
-                break
-            step = np.linalg.lstsq(J - np.eye(manifold.dim), -manifold.coordinates(res),
-                                   rcond=None)[0]
-            x = manifold.move(x, step)
-    except ParameterError as exc:
-        return _failed(str(exc), shooter.period_s(ex), periods, t_wall)
-    return shooter.orbit(x, regime, ex, record, J, history, iterations, status, message, t_wall)
+    orbit = None
+    for k, phase in enumerate(phases):
+        shooter.phase = float(phase)
+        orbit = shooter.find(guess if k == 0 else None, newton_tol, max_newton, t_wall)
+        if orbit.status in ("ok", "grazing"):
+            break
+    return orbit
 
 
 def lattice(params, ex, period_s: float) -> tuple[float, float]:
@@ -440,7 +479,7 @@ def lattice(params, ex, period_s: float) -> tuple[float, float]:
     from .step_policy import default_dt
     n = int(np.ceil(period_s / default_dt(params, ex) - 1e-9))
     decim = max(1, int(np.ceil(n / SAMPLES_PER_PERIOD)))
-    n = decim * int(np.ceil(n / decim))
+    n = len(PHASES) * decim * int(np.ceil(n / (len(PHASES) * decim)))   # the phases on it
     dt = period_s / n
     return dt, 1.0 / (decim * dt)
 

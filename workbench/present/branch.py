@@ -57,6 +57,10 @@ def write_branch(branch: Branch, out: Path, params) -> None:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     table = pd.DataFrame(branch_rows(branch))
+    if not len(table):
+        table = pd.DataFrame({branch.parameter: pd.Series(dtype=float),
+                              "stable": pd.Series(dtype=bool),
+                              "bifurcation": pd.Series(dtype=str)})
     write_atomic(table, out / "branch.parquet")
     if branch.status == "running":
         return
