@@ -297,6 +297,17 @@ def _cmd_params(args) -> int:
     return EXIT_OK
 
 
+def _add_orbit_options(parser) -> None:
+    """The options ``orbit`` and ``continue`` share: the model, the joint, the periods, JSON."""
+    add_model_options(parser)
+    add_joint_options(parser)
+    parser.add_argument("--periods", type=number(1, 64, integer=True), default=1,
+                        help="drive periods of an orbit (default 1; 2 for a period doubling)")
+    parser.add_argument("--joint", choices=("free", "locked"), default="free",
+                        help="free (default) or locked (s = v = psi = 0)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
 def add_parsers(sub) -> None:
     """Add this module's sub-commands to the parser's ``sub``."""
     from ..model import drives
@@ -346,35 +357,23 @@ def add_parsers(sub) -> None:
 
     orbit = sub.add_parser("orbit", help="a periodic response of a sine drive by shooting, and "
                            "its Floquet multipliers (model/orbit.py)")
-    add_model_options(orbit)
-    add_joint_options(orbit)
+    _add_orbit_options(orbit)
     orbit.add_argument("--freq-hz", type=number(0, lo_open=True), required=True,
                        help="the sine's frequency (Hz)")
     orbit.add_argument("--force-n", type=number(0, MAX_FORCE_N, lo_open=True),
                        default=drives.DEFAULT_FORCE_N,
                        help=f"the sine's amplitude (N; default {drives.DEFAULT_FORCE_N:g})")
-    orbit.add_argument("--periods", type=number(1, 64, integer=True), default=1,
-                       help="drive periods of the orbit (default 1; 2 for a period doubling)")
-    orbit.add_argument("--joint", choices=("free", "locked"), default="free",
-                       help="free (default) or locked (s = v = psi = 0)")
-    orbit.add_argument("--json", action="store_true", help="print one JSON object")
     orbit.set_defaults(func=_cmd_orbit)
 
     cont = sub.add_parser("continue", help="a branch of periodic orbits over the drive's "
                           "frequency or force (model/continuation.py)")
-    add_model_options(cont)
-    add_joint_options(cont)
+    _add_orbit_options(cont)
     cont.add_argument("--freq-hz", type=value_or_range, required=True,
                       help="the sine's frequency (Hz), or LO:HI to continue over it")
     cont.add_argument("--force-n", type=value_or_range, default=drives.DEFAULT_FORCE_N,
                       help=f"the sine's amplitude (N; default {drives.DEFAULT_FORCE_N:g}), or "
                       "LO:HI to continue over it")
-    cont.add_argument("--periods", type=number(1, 64, integer=True), default=1,
-                      help="drive periods of the orbits (default 1)")
-    cont.add_argument("--joint", choices=("free", "locked"), default="free",
-                      help="free (default) or locked (s = v = psi = 0)")
     cont.add_argument("--out", help="output folder (default results/continue/<parameter>-LO-HI)")
-    cont.add_argument("--json", action="store_true", help="print a one-line JSON summary")
     cont.set_defaults(func=_cmd_continue)
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "
