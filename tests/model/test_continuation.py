@@ -68,6 +68,14 @@ def test_a_multiplier_leaving_the_unit_circle_names_the_bifurcation(before, afte
     assert _bifurcation(_orbit([0.5]), _orbit([0.5], grazing=True)) == "grazing"
 
 
+def test_a_branch_is_traced_downwards_too():
+    """22 to 21 Hz at 0.5 N: the same orbits as upwards (the frequencies decrease)."""
+    shooter = Shooter(Parameters(), drives.sine(0.5, 22.0), parameter="freq_hz")
+    branch = continue_branch(shooter, 22.0, 21.0)
+    values = [v for v, _ in branch.orbits]
+    assert branch.status == "done" and values[-1] < 21.0 and np.all(np.diff(values) < 0)
+
+
 def test_an_interrupted_continuation_keeps_every_orbit_found(tmp_path):
     p = Parameters()
     shooter = Shooter(p, drives.sine(0.5, 20.0), parameter="freq_hz")
@@ -85,8 +93,11 @@ def test_an_interrupted_continuation_keeps_every_orbit_found(tmp_path):
 
 
 def test_the_continue_command_refuses_what_it_cannot_trace(tmp_path, capsys):
-    assert cli.main(["continue", "--freq-hz", "25:15", "--out", str(tmp_path)]) == 2
-    assert "a range is LO:HI with LO below HI" in capsys.readouterr().err
+    assert cli.main(["continue", "--freq-hz", "25:25", "--out", str(tmp_path)]) == 2
+    assert "a range is FROM:TO, two different finite numbers" in capsys.readouterr().err
+    assert cli.main(["continue", "--freq-hz", "20", "--force-n", "20000:10", "--out",
+                     str(tmp_path)]) == 2
+    assert "--force-n 20000:10: allowed (0, 10000] N" in capsys.readouterr().err
     assert cli.main(["continue", "--freq-hz", "20", "--force-n", "10", "--out",
                      str(tmp_path)]) == 2
     assert "give one of --freq-hz and --force-n as a range" in capsys.readouterr().err

@@ -227,17 +227,18 @@ def _cmd_orbit(args) -> int:
 
 
 def value_or_range(text: str):
-    """A number, or LO:HI (two numbers, LO below HI)."""
+    """A number, or FROM:TO (two different numbers; the continuation starts at FROM)."""
     import argparse
     parts = text.split(":")
     try:
         values = [float(v) for v in parts]
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number or LO:HI") from None
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number or FROM:TO") from None
     if len(values) == 1:
         return values[0]
-    if len(values) != 2 or not values[0] < values[1] or not all(map(math.isfinite, values)):
-        raise argparse.ArgumentTypeError(f"{text!r}: a range is LO:HI with LO below HI")
+    if len(values) != 2 or values[0] == values[1] or not all(map(math.isfinite, values)):
+        raise argparse.ArgumentTypeError(f"{text!r}: a range is FROM:TO, two different "
+                                         "finite numbers")
     return tuple(values)
 
 
@@ -251,13 +252,13 @@ def _cmd_continue(args) -> int:
     ranges = [(name, v) for name, v in (("freq_hz", args.freq_hz), ("force_n", args.force_n))
               if isinstance(v, tuple)]
     if len(ranges) != 1:
-        raise ParameterError("give one of --freq-hz and --force-n as a range LO:HI (the other "
+        raise ParameterError("give one of --freq-hz and --force-n as a range FROM:TO (the other "
                              "a value)")
     parameter, (lo, hi) = ranges[0]
     option = "--" + parameter.replace("_", "-")
-    if parameter == "freq_hz" and lo <= 0:
+    if parameter == "freq_hz" and min(lo, hi) <= 0:
         raise ParameterError(f"{option} {lo:g}:{hi:g}: allowed (0, inf) Hz")
-    if parameter == "force_n" and not 0 < lo and hi <= MAX_FORCE_N:
+    if parameter == "force_n" and not (0 < min(lo, hi) and max(lo, hi) <= MAX_FORCE_N):
         raise ParameterError(f"{option} {lo:g}:{hi:g}: allowed (0, {MAX_FORCE_N:g}] N")
     p = parameters_of(args)
     freq = lo if parameter == "freq_hz" else args.freq_hz
@@ -369,11 +370,12 @@ def add_parsers(sub) -> None:
                           "frequency or force (model/continuation.py)")
     _add_orbit_options(cont)
     cont.add_argument("--freq-hz", type=value_or_range, required=True,
-                      help="the sine's frequency (Hz), or LO:HI to continue over it")
+                      help="the sine's frequency (Hz), or FROM:TO to continue over it (either "
+                      "way)")
     cont.add_argument("--force-n", type=value_or_range, default=drives.DEFAULT_FORCE_N,
                       help=f"the sine's amplitude (N; default {drives.DEFAULT_FORCE_N:g}), or "
-                      "LO:HI to continue over it")
-    cont.add_argument("--out", help="output folder (default results/continue/<parameter>-LO-HI)")
+                      "FROM:TO to continue over it (either way)")
+    cont.add_argument("--out", help="output folder (default results/continue/<parameter>-FROM-TO)")
     cont.set_defaults(func=_cmd_continue)
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "

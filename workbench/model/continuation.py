@@ -18,7 +18,8 @@ orbit's state at phase 0 passes an event along the branch (the period map ends i
 regime than it starts from), the orbit at the predicted parameter is found by shooting
 from the predicted state in the regime it reaches, and taken if it lies within JUMP x ds of
 the last (on the error scales).  The branch ends, with its status, when ds falls below
-DS_MIN, when lambda leaves [lo, hi], or when it folds back past its start.
+DS_MIN, when lambda passes the range's end, or when it folds back past its start (a range
+may run downwards: from 200 N to 40 N).
 
 At each orbit its multipliers are computed; between two orbits whose stability they decide
 (beyond their error estimate, :mod:`workbench.model.orbit`; orbits between them whose
@@ -84,14 +85,16 @@ def _bifurcation(before: Orbit, after: Orbit) -> str:
 def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable | None = None,
                     ds: float = DS_FIRST, start: Orbit | None = None) -> Branch:
     """Trace the branch of ``shooter``'s orbits from its parameter ``lo`` towards ``hi``
-    (module docstring); ``on_orbit(branch)`` is called after each orbit (to write it out).
-    ``start``: an orbit at ``lo`` (default: found from the state after a run)."""
+    (module docstring; ``hi`` may be below ``lo``: the branch is traced downwards);
+    ``on_orbit(branch)`` is called after each orbit (to write it out).  ``start``: an orbit
+    at ``lo`` (default: found from the state after a run)."""
     from .orbit import periodic_orbit
     t0 = time.perf_counter()
-    if not lo < hi:
-        raise ParameterError(f"the range {lo:g}:{hi:g} must be increasing")
+    if lo == hi:
+        raise ParameterError(f"the range {lo:g}:{hi:g} is empty")
+    direction = 1.0 if hi > lo else -1.0
     branch = Branch(shooter.parameter)
-    span = hi - lo
+    span = abs(hi - lo)
     if start is None:
         start = periodic_orbit(shooter.params, shooter.drive_at(lo), shooter.periods,
                                fixed=shooter.fixed)
@@ -115,7 +118,7 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
             shooter.monodromy(manifold, orbit.state, orbit.regime, ex, scale)
         dR = shooter.d_parameter(manifold, orbit.state, orbit.regime, value)
         pin = _pin(orbit, manifold, d)
-        tangent = _tangent(J, dR, d, manifold, tangent, pin)
+        tangent = _tangent(J, dR, d, manifold, tangent, pin, direction)
         accepted = None
         while accepted is None:
             if ds < DS_MIN:
@@ -138,10 +141,10 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         branch.orbits.append((new_value, new_orbit))
         if iterations <= EASY:
             ds = min(DS_MAX, ds * GROW)
-        if new_value > hi:
+        if (new_value - hi) * direction > 0:
             branch.status, branch.message = "done", f"reached {hi:g}"
             return _done(branch, t0, on_orbit)
-        if new_value < lo - 1e-9 * span:
+        if (new_value - lo) * direction < -1e-9 * span:
             branch.status, branch.message = "folded back", (
                 f"the branch turned back past its start {lo:g} (at {new_value:.6g})")
             return _done(branch, t0, on_orbit)
@@ -167,10 +170,10 @@ def _pin(orbit, manifold, d) -> np.ndarray | None:
     return row / np.linalg.norm(row)
 
 
-def _tangent(J, dR, d, manifold, previous, pin=None) -> np.ndarray:
+def _tangent(J, dR, d, manifold, previous, pin=None, direction: float = 1.0) -> np.ndarray:
     """The unit tangent (scaled) of the branch: the null vector of [J - I, dR] on the scales
-    (and of the pin, :func:`_pin`), oriented along ``previous`` (else towards larger
-    lambda)."""
+    (and of the pin, :func:`_pin`), oriented along ``previous`` (else towards lambda's
+    ``direction``)."""
     n = manifold.dim
     A = np.hstack([(J - np.eye(n)) * d[:n][None, :], (dR * d[n])[:, None]]) / d[:n][:, None]
     if pin is not None:
@@ -180,7 +183,7 @@ def _tangent(J, dR, d, manifold, previous, pin=None) -> np.ndarray:
     t /= np.linalg.norm(t)
     if previous is not None and len(previous) == len(t):
         return t if t @ previous >= 0 else -t
-    return t if t[-1] >= 0 else -t
+    return t if t[-1] * direction >= 0 else -t
 
 
 def _correct(shooter, orbit, value, manifold, d, tangent, ds, pin=None):
