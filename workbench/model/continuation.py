@@ -36,9 +36,9 @@ from typing import Callable
 
 import numpy as np
 
-from ..core import layout as ly
 from .orbit import Orbit, Shooter, error_scales, reduced_scales, stuck_direction
 from .params import ParameterError
+from .regimes import contact_code
 
 #: Step control (scaled arclength): first step, smallest, largest, growth, easy corrector.
 DS_FIRST = 0.02
@@ -266,7 +266,7 @@ def branch_rows(branch: Branch) -> list[dict]:
                "stability": {True: "stable", False: "unstable", None: "undetermined"}[
                    orbit.stable],
                "grazing": orbit.grazing,
-               "contact_code_at_phase0": int(ly.CONTACT_CODE[(orbit.regime + 1) // 2]),
+               "contact_code_at_phase0": int(contact_code(orbit.regime)),
                "bifurcation": kinds.get(i, ""), "newton_iterations": orbit.newton_iterations,
                "residual": orbit.residual}
         rows.append(row)

@@ -52,11 +52,10 @@ import numpy as np
 
 from ..core import excitation as cx
 from ..core import layout as ly
-from ..core.config import REF_RATE
 from ..core.contact import eval_geometry
 from . import packing as mdl
 from .params import ParameterError, Parameters
-from .regimes import contact_code
+from .regimes import SETS, contact_code, in_contact, is_stick, set_of
 
 #: The guess: drive periods from the static equilibrium, the first RAMP_PERIODS a soft start.
 GUESS_PERIODS = 30
@@ -155,29 +154,32 @@ def sine_of(drive) -> tuple[np.ndarray, float]:
     return ex, float(ex[cx.X_FREQ])
 
 
+def _geometry(P, q) -> np.ndarray:
+    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
+    eval_geometry(q, P, cg)
+    return cg
+
+
+def _row(cg, r) -> np.ndarray:
+    """Geometry row r (CG_G + k or CG_T + k) as a gradient in q (9; only s, v, psi move it)."""
+    row = np.zeros(ly.N_DOF)
+    row[ly.S], row[ly.V], row[ly.PSI] = cg[r, ly.CG_DS], cg[r, ly.CG_DV], cg[r, ly.CG_DPSI]
+    return row
+
+
 def constraint_rows(P: np.ndarray, q: np.ndarray, regime: int) -> np.ndarray:
     """The active constraint rows W (m x 9) of a regime at q: the closed points' gap gradients
     and, sticking, the first point's tangential gradient (docs/model.md §7)."""
-    k = (regime + 1) // 2
-    if k == 0:
-        return np.zeros((0, ly.N_DOF))
-    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
-    eval_geometry(q, P, cg)
-    rows = [ly.CG_G + p for p in (ly.SET_FIRST[k], ly.SET_SECOND[k]) if p >= 0]
-    if regime % 2 == 1:
-        rows.append(ly.CG_T + ly.SET_FIRST[k])
-    W = np.zeros((len(rows), ly.N_DOF))
-    for i, r in enumerate(rows):
-        W[i, ly.S], W[i, ly.V], W[i, ly.PSI] = cg[r, ly.CG_DS], cg[r, ly.CG_DV], cg[r, ly.CG_DPSI]
-    return W
+    points = SETS[set_of(regime)]
+    rows = [ly.CG_G + p for p in points] + ([ly.CG_T + points[0]] if is_stick(regime) else [])
+    cg = _geometry(P, q)
+    return np.array([_row(cg, r) for r in rows]).reshape(len(rows), ly.N_DOF)
 
 
 def _gaps(P, q, regime) -> np.ndarray:
-    k = (regime + 1) // 2
-    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
-    eval_geometry(q, P, cg)
-    return np.array([cg[ly.CG_G + p, ly.CG_VAL] for p in (ly.SET_FIRST[k], ly.SET_SECOND[k])
-                     if k and p >= 0])
+    """The closed points' gaps (cm) of a regime at q."""
+    cg = _geometry(P, q)
+    return np.array([cg[ly.CG_G + p, ly.CG_VAL] for p in SETS[set_of(regime)]])
 
 
 def _null_basis(W: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -248,12 +250,10 @@ def error_scales(P, states: np.ndarray) -> np.ndarray:
     """The integrator's error scale of each component of (q, q') over a record of states
     (``core.error_scales``: the floor from the clearance, the largest |value| of it or its
     partner)."""
-    from ..core.error_scales import PARTNER
-    floor = np.full(ly.N_DOF, P[ly.P_GAP])
-    floor[ly.PHI_A] /= P[ly.P_L_A]
-    floor[ly.PHI_B] /= P[ly.P_L_B]
-    floor[ly.PSI] /= P[ly.P_L4]
-    floor = np.concatenate([floor, REF_RATE * floor])
+    from ..core.error_scales import PARTNER, floors
+    scale = np.zeros((ly.N_SCALE_ROWS, ly.N_STATE))
+    floors(P, scale)
+    floor = scale[ly.SCALE_FLOOR]
     peak = np.abs(states[:, :ly.N_STATE]).max(axis=0)
     partner = np.concatenate([peak[:ly.N_DOF][list(PARTNER)],
                               peak[ly.N_DOF:][list(PARTNER)]])
@@ -498,11 +498,8 @@ def stuck_direction(manifold, x) -> np.ndarray | None:
     flight."""
     if manifold.regime == 0:
         return None
-    cg = np.zeros((2 * ly.N_POINTS, ly.N_CG))
-    eval_geometry(x[:ly.N_DOF], manifold.P, cg)
-    row = np.zeros(ly.N_DOF)
-    t = ly.CG_T + ly.SET_FIRST[(manifold.regime + 1) // 2]
-    row[ly.S], row[ly.V], row[ly.PSI] = cg[t, ly.CG_DS], cg[t, ly.CG_DV], cg[t, ly.CG_DPSI]
+    first = SETS[set_of(manifold.regime)][0]
+    row = _row(_geometry(manifold.P, x[:ly.N_DOF]), ly.CG_T + first)
     along = np.concatenate([manifold.Nq.T @ row, np.zeros(manifold.Nv.shape[1])])
     return along / max(np.linalg.norm(along), 1e-300)
 
@@ -536,12 +533,7 @@ def _orbit_facts(record, P, periods, T) -> dict:
     tip = record.signal("tip_y")
     regimes = record.signal("regime").astype(int)
     gaps = np.stack([record.signal(f"gap{k + 1}") for k in range(ly.N_POINTS)], axis=1)
-    closed = np.zeros_like(gaps, dtype=bool)
-    for i, r in enumerate(regimes):
-        k = (r + 1) // 2
-        for p in (ly.SET_FIRST[k], ly.SET_SECOND[k]):
-            if k and p >= 0:
-                closed[i, p] = True
+    closed = np.stack([in_contact(p, regimes) for p in range(ly.N_POINTS)], axis=1) == 1
     open_gaps = np.where(closed, np.inf, gaps)
     # a graze: an open gap's minimum in time (not the approach to a closing)
     inner = ((open_gaps[1:-1] < open_gaps[:-2]) & (open_gaps[1:-1] <= open_gaps[2:])

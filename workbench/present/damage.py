@@ -23,13 +23,16 @@ import pandas as pd
 from ..study.grid import label, panels, point_title
 from ..study.wear import WEAR_SOURCES, WearConstants
 from . import figures as F
+from . import units
 from .tables import latex_text, latex_units
 
+#: mm³ per cm³ and mJ per erg (``model.shown_units``).
+MM3, MJ = units.si("cm³")[1], units.si("erg")[1]
 #: The measures a map can show: (column, title, CGS unit -> SI factor, SI unit).
 MAP_MEASURES = {
-    "wear_volume_cm3": ("wear volume per cycle (Archard)", 1e3, "mm³"),
-    "impact_energy_erg": ("impact energy lost per cycle", 1e-4, "mJ"),
-    "friction_work_erg": ("friction work per cycle", 1e-4, "mJ"),
+    "wear_volume_cm3": ("wear volume per cycle (Archard)", MM3, "mm³"),
+    "impact_energy_erg": ("impact energy lost per cycle", MJ, "mJ"),
+    "friction_work_erg": ("friction work per cycle", MJ, "mJ"),
     "impacts": ("impacts per cycle", 1.0, ""),
 }
 AXES = ("freq_hz", "force_n")
@@ -43,7 +46,7 @@ def is_wear_map(table: pd.DataFrame) -> bool:
 
 def avoid(table: pd.DataFrame, wear: WearConstants) -> pd.Series:
     """True where a finished point's wear volume per cycle is at or above the threshold."""
-    return (table.status == "ok") & (table.wear_volume_cm3 * 1e3 >= wear.threshold_mm3)
+    return (table.status == "ok") & (table.wear_volume_cm3 * MM3 >= wear.threshold_mm3)
 
 
 def wear_map(table: pd.DataFrame, measure: str, wear: WearConstants):
@@ -67,7 +70,7 @@ def wear_map(table: pd.DataFrame, measure: str, wear: WearConstants):
         for _, r in part[part.status == "ok"].iterrows():
             i, j = np.searchsorted(forces, r.axis_force_n), np.searchsorted(freqs, r.axis_freq_hz)
             grid[i, j] = max(r[measure] * factor, bottom)
-            volume[i, j] = r.wear_volume_cm3 * 1e3
+            volume[i, j] = r.wear_volume_cm3 * MM3
         filled = ax.contourf(freqs, forces, grid, levels=levels, norm=norm, cmap="magma_r",
                              extend="both")
         if np.nanmax(volume, initial=0.0) >= wear.threshold_mm3:
@@ -106,11 +109,11 @@ def extremes_table(table: pd.DataFrame, wear: WearConstants) -> pd.DataFrame:
             worst = level.loc[level.wear_volume_cm3.idxmax()]
             rows.append({"panel": name or "all", "force [N]": force,
                          "safest [Hz]": best.axis_freq_hz,
-                         "its wear [mm³/cycle]": best.wear_volume_cm3 * 1e3,
-                         "its impact energy [mJ/cycle]": best.impact_energy_erg * 1e-4,
+                         "its wear [mm³/cycle]": best.wear_volume_cm3 * MM3,
+                         "its impact energy [mJ/cycle]": best.impact_energy_erg * MJ,
                          "worst [Hz]": worst.axis_freq_hz,
-                         "its wear [mm³/cycle] ": worst.wear_volume_cm3 * 1e3,
-                         "its impact energy [mJ/cycle] ": worst.impact_energy_erg * 1e-4,
+                         "its wear [mm³/cycle] ": worst.wear_volume_cm3 * MM3,
+                         "its impact energy [mJ/cycle] ": worst.impact_energy_erg * MJ,
                          "avoid at": ", ".join(f"{f:g}" for f in level[avoid(level, wear)]
                                                .axis_freq_hz.sort_values()) or "-"})
     return pd.DataFrame(rows)

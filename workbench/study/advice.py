@@ -27,17 +27,18 @@ import numpy as np
 import pandas as pd
 
 from ..model.params import ParameterError
+from ..model.shown_units import SI
 from .wear import WearConstants
 
 #: The frequency step (Hz) of the search for the nearest frequency out of the regime to avoid.
 FREQ_STEP_HZ = 0.5
 #: The measures the advice gives: column -> (name, SI factor, SI unit).
 ADVICE_MEASURES = {
-    "wear_volume_cm3": ("wear_volume_mm3", 1e3, "mm³/cycle"),
-    "friction_work_erg": ("friction_work_mj", 1e-4, "mJ/cycle"),
-    "impact_energy_erg": ("impact_energy_mj", 1e-4, "mJ/cycle"),
+    "wear_volume_cm3": ("wear_volume_mm3", SI["cm³"][1], "mm³/cycle"),
+    "friction_work_erg": ("friction_work_mj", SI["erg"][1], "mJ/cycle"),
+    "impact_energy_erg": ("impact_energy_mj", SI["erg"][1], "mJ/cycle"),
     "impacts": ("impacts_per_cycle", 1.0, "1/cycle"),
-    "normal_force_max_dyn": ("normal_force_max_n", 1e-5, "N"),
+    "normal_force_max_dyn": ("normal_force_max_n", SI["dyn"][1], "N"),
 }
 
 
