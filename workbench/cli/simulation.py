@@ -10,7 +10,7 @@ import time
 import numpy as np
 
 from ..model.limits import (DEFAULT_TOL, MAX_DT, MAX_DURATION_S, MAX_FORCE_N, MAX_OUTPUT_HZ,
-                            MIN_DT)
+                            MIN_DT, MONODROMY_METHODS)
 from ..model.params import ParameterError, describe
 from ..model.shown_units import SI
 from ..study.paths import check_output_dir, check_output_file
@@ -205,7 +205,8 @@ def _cmd_orbit(args) -> int:
     from ..model.packing import JOINT
     p = parameters_of(args)
     orbit = periodic_orbit(p, drives.sine(args.force_n, args.freq_hz), periods=args.periods,
-                           fixed=JOINT if args.joint == "locked" else ())
+                           fixed=JOINT if args.joint == "locked" else (),
+                           monodromy=args.monodromy)
     found = orbit.to_dict()
     if args.json:
         print(json_text({key: value for key, value in found.items() if key != "state"}))
@@ -265,7 +266,7 @@ def _cmd_continue(args) -> int:
     force = lo if parameter == "force_n" else args.force_n
     out = check_output_dir("--out", args.out or RESULTS / "continue" / f"{parameter}-{lo:g}-{hi:g}")
     shooter = Shooter(p, drives.sine(force, freq), args.periods,
-                      JOINT if args.joint == "locked" else (), parameter)
+                      JOINT if args.joint == "locked" else (), parameter, args.monodromy)
     branch = continue_branch(shooter, lo, hi, on_orbit=lambda b: write_branch(b, out, p))
     rows = branch_rows(branch)
     summary = {"status": branch.status, "message": branch.message, "parameter": parameter,
@@ -306,6 +307,9 @@ def _add_orbit_options(parser) -> None:
                         help="drive periods of an orbit (default 1; 2 for a period doubling)")
     parser.add_argument("--joint", choices=("free", "locked"), default="free",
                         help="free (default) or locked (s = v = psi = 0)")
+    parser.add_argument("--monodromy", choices=MONODROMY_METHODS, default="variational",
+                        help="the period map's Jacobian from the variational equations with "
+                        "saltation matrices (default) or by finite differences of the map")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
 
 

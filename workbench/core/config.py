@@ -165,3 +165,19 @@ FD_COORD = 1e-7
 FD_FORCE = 1e-3
 #: The line search halves alpha down to this, then takes the last alpha tried.
 ALPHA_MIN = 1e-4
+
+# --- variational equations (the monodromy of a periodic orbit) -------------------
+#: Forward-difference step of the state Jacobian df/dy, relative to each
+#: component's error scale: the truncation error ~1e-7 of the largest curvature
+#: over a scale, the round-off ~1e-16 / 1e-7 of f.
+VAR_FD_REL = 1e-7
+#: Central-difference step of an event's jump map and event-function gradient,
+#: relative to the error scales (no integration in between: round-off ~1e-10).
+JUMP_FD_REL = 1e-6
+#: Time step (s) of the event function's total rate along the old regime's flow
+#: (central differences; the fastest mode, ~6 kHz, moves by 4e-5 rad in it).
+EVENT_DT_FD_S = 1e-9
+#: The variational equations' step (s) at most, and its floor: the run's own
+#: steps are 2e-5..1e-4 s; a step below the floor is a failure (ERR_STEP_FLOOR).
+VAR_H_MAX_S = 1e-3
+VAR_H_MIN_S = 1e-12

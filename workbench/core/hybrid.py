@@ -432,14 +432,17 @@ def _accumulating(t, y, point, P, cg, st, k1):
 
 
 @nb.njit(**JIT)
-def apply_event(e, t, model, ex, work, log, n_log, st):
-    """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
+def event_transition(e, t, model, ex, work, log, n_log, st):
+    """The transition of event e at the state in STAGE_CUR (time t), before the new regime
+    is chosen: the state projected onto the old regime, then the impact law (an impact,
+    its log row n_log written) or the new contact set or stick flag in rg.
 
-    Returns a status; the log row n_log is written.
+    Returns ``(status, kind, point, reg_from, gap_tol)``: the log's kind and point, the
+    regime before, the gap tolerance the choice of the new regime takes.
     """
     P, tab, kc, free = model.P, model.tab, model.kc, model.free
     rec, mat, vec, stages = work.rec, work.mat, work.vec, work.stages
-    cg, cw, rg, ev = work.cg, work.cw, work.rg, work.ev
+    cg, cw, rg = work.cg, work.cw, work.rg
     y = stages[ly.STAGE_CUR]
     k1 = stages[ly.STAGE_K1]
     set_index = int(rg[ly.RG_SET])
@@ -448,12 +451,12 @@ def apply_event(e, t, model, ex, work, log, n_log, st):
     # so that e.g. a sticking slip velocity is exactly 0 when slip begins.
     project(y, P, free, cg, cw, rg, np.bool_(False))
     status = rhs_regime(t, y, model, ex, work, k1)
-    if status != ly.OK:
-        return status
     point = 0
     kind = ly.KIND_START
     gap_tol = GAP_TOL
     lost = 0.0
+    if status != ly.OK:
+        return status, kind, point, reg_from, gap_tol
     if e < ly.EV_GAP + ly.N_POINTS:
         p = e - ly.EV_GAP
         accumulating = _accumulating(t, y, p, P, cg, st, k1)
@@ -464,11 +467,11 @@ def apply_event(e, t, model, ex, work, log, n_log, st):
         free_acc = stages[ly.STAGE_TRY]
         status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, free_acc)
         if status != ly.OK:
-            return status
+            return status, kind, point, reg_from, gap_tol
         status, n_pts, lost = impact(y, p, P, free, mat, cg, cw, rg, gap_tol,
                                      free_acc[ly.N_DOF:ly.N_STATE], close_within, np.float64(0.0))
         if status != ly.OK:
-            return status
+            return status, kind, point, reg_from, gap_tol
         row = log[_log(log, n_log, t, ly.KIND_IMPACT, reg_from, 0, p + 1)]
         for i in range(n_pts):
             q = int(cw[ly.CW_PTS, i])
@@ -502,7 +505,23 @@ def apply_event(e, t, model, ex, work, log, n_log, st):
         project(y, P, free, cg, cw, rg, np.bool_(False))
         kind = ly.KIND_SLIP_STICK
         point = ly.SET_FIRST[set_index] + 1
-    status = choose_regime(t, y, model, ex, work, k1, st, gap_tol)
+    return ly.OK, kind, point, reg_from, gap_tol
+
+
+@nb.njit(**JIT)
+def apply_event(e, t, model, ex, work, log, n_log, st):
+    """Apply event e at the state in STAGE_CUR (time t); leave k1 and the events there.
+
+    Returns a status; the log row n_log is written.
+    """
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    y = stages[ly.STAGE_CUR]
+    status, kind, point, reg_from, gap_tol = event_transition(e, t, model, ex, work, log,
+                                                              n_log, st)
+    if status != ly.OK:
+        return status
+    status = choose_regime(t, y, model, ex, work, stages[ly.STAGE_K1], st, gap_tol)
     if status != ly.OK:
         return status
     reg_to = regime_of(int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)

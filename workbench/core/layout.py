@@ -115,6 +115,9 @@ ERR_NO_IMPACT_CANDIDATE = 5
 ERR_NO_REGIME = 6
 LOG_FULL = 7     # not an error: the event log is full, call again to continue
 STOPPED = 8      # not a kernel's: simulate(stop=...) ended the run early, as asked
+ERR_JUMP_AMBIGUOUS = 9   # an event's outcome changes within the differencing step (core.variational)
+ERR_EVENT_TANGENT = 10   # the orbit meets the event surface tangentially: dh/dt = 0 (core.variational)
+ERR_STEP_FLOOR = 11      # the variational equations' step fell below its floor (core.variational)
 
 MESSAGES = {
     OK: "finished",
@@ -127,6 +130,11 @@ MESSAGES = {
                    "a force or friction condition)",
     LOG_FULL: "the event log is full (the run continues in a new chunk)",
     STOPPED: "stopped early by the caller's condition",
+    ERR_JUMP_AMBIGUOUS: "an event's outcome (the regime after it) changes within the "
+                        "differencing step: the jump is not differentiable there",
+    ERR_EVENT_TANGENT: "the orbit meets an event surface tangentially (dh/dt = 0): no "
+                       "saltation matrix",
+    ERR_STEP_FLOOR: "the variational equations' step fell below its floor",
 }
 
 # --- status codes of the static equilibrium (workbench.core.equilibrium) -------

@@ -10,8 +10,8 @@ method on
 
     R(z, lambda) = Phi(x(z), lambda) - x(z) = 0,    t0 . (u - u0) - ds = 0,
 
-its Jacobian [[J - I, dR/dlambda], [t0]] (J the finite-difference monodromy, dR/dlambda two
-more integrations).  The step ds grows by GROW after a corrector of at most EASY iterations,
+its Jacobian [[J - I, dR/dlambda], [t0]] (J the monodromy of :mod:`workbench.model.orbit`,
+dR/dlambda by central differences of the map, two more integrations).  The step ds grows by GROW after a corrector of at most EASY iterations,
 halves after a failed one (a corrector that does not converge in MAX_CORRECTOR iterations,
 or a new orbit farther than JUMP x ds from the last: a jump to another branch).  Where the
 orbit's state at phase 0 passes an event along the branch (the period map ends in another
@@ -115,7 +115,7 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         d = np.concatenate([reduced_scales(manifold, scale), [span]])
         J = orbit.monodromy if orbit.monodromy is not None and \
             orbit.monodromy.shape[0] == manifold.dim else \
-            shooter.monodromy(manifold, orbit.state, orbit.regime, ex, scale)
+            shooter.monodromy(manifold, orbit.state, orbit.regime, ex, record, scale)[0]
         dR = shooter.d_parameter(manifold, orbit.state, orbit.regime, value)
         pin = _pin(orbit, manifold, d)
         tangent = _tangent(J, dR, d, manifold, tangent, pin, direction)
@@ -202,12 +202,12 @@ def _correct(shooter, orbit, value, manifold, d, tangent, ds, pin=None):
             history.append(residual)
             if end_regime != orbit.regime:
                 return None
-            J = shooter.monodromy(manifold, x, orbit.regime, ex, scale)
+            J, method = shooter.monodromy(manifold, x, orbit.regime, ex, record, scale)
             if residual <= CORRECTOR_TOL:
                 if np.linalg.norm(u) > JUMP * ds:
                     return None
                 found = shooter.orbit(x, orbit.regime, ex, record, J, history, it, "ok",
-                                      "found", t_wall)
+                                      "found", t_wall, method)
                 return lam, found, it
             dR = shooter.d_parameter(manifold, x, orbit.regime, lam)
             F = np.concatenate([manifold.coordinates(res) / d[:n], [tangent @ u - ds]])

@@ -57,3 +57,6 @@ ACCEL_RANGE_G = 50.0
 #: The force transducer's range (N): PCB Piezotronics 208C03 (seed Table 1), 2224 N (500 lbf)
 #: by the maker's datasheet (ASSUMPTION, as above).
 FORCE_RANGE_N = 2224.0
+#: How a periodic orbit's monodromy may be taken (:mod:`workbench.model.orbit`), the default
+#: first.
+MONODROMY_METHODS = ("variational", "finite-difference")

@@ -16,12 +16,16 @@ active rows W (q-space), positions q + Nq a and rates q' + Nv b - W^+ (dW[Nq a])
 correction keeps W(q) q' = 0 to first order).  Free flight: 18 coordinates; the stuck joint
 (two points closed, sticking) 7 + 6 = 13.
 
-**Monodromy.**  The Jacobian of the K-period map in those coordinates, by central finite
-differences of the map, 2 x dim integrations of K periods per Newton step (through every
-event of the orbit: away from grazing the map is smooth there).  Its eigenvalues are the
-Floquet multipliers (the reduced system's; the constrained directions have none); the
-multipliers' error is estimated by the monodromy again with a step CHECK_STEP times larger
-(``multiplier_error``, the largest shift of a multiplier); the orbit is stable when every
+**Monodromy.**  The Jacobian of the K-period map in those coordinates: by default from the
+variational equations along the map's run with a saltation matrix at each of its events
+(:mod:`workbench.model.monodromy`, in the full state, then reduced), about as costly as ten
+periods of integration; by central finite differences of the map (``monodromy=
+"finite-difference"``, 2 x dim integrations of K periods) where asked, or where the run has
+no saltation matrices (Moreau-Jean steps, an event met tangentially; the orbit's message
+says so).  Its eigenvalues are the Floquet multipliers (the reduced system's; the
+constrained directions have none); the multipliers' error is estimated by the monodromy
+again at CHECK_FACTOR times the tolerance and the state Jacobian's difference step
+(variational) or the map's difference step (finite differences) (``multiplier_error``, the largest shift of a multiplier); the orbit is stable when every
 |multiplier| is below 1 by more than that, unstable when one is above 1 by more, and its
 stability undetermined (``stable`` null, the message says so) in between; all but the
 neutral one: where
@@ -39,9 +43,7 @@ grow, or leaves the regime, is halved (BACKTRACK times at most).
 of the clearance of zero (it touches without closing) is flagged: its multipliers are not defined there (the map is not
 differentiable), and the status says so.
 
-Limits: only a sine drive (a forcing period); the finite-difference monodromy is the check
-of the variational equations with saltation matrices, which the workbench does not yet
-integrate (docs/usage.md).
+Limits: only a sine drive (a forcing period) (docs/usage.md).
 """
 from __future__ import annotations
 
@@ -54,6 +56,8 @@ from ..core import excitation as cx
 from ..core import layout as ly
 from ..core.contact import eval_geometry
 from . import packing as mdl
+from ..core.config import VAR_FD_REL
+from .limits import MONODROMY_METHODS
 from .params import ParameterError, Parameters
 from .regimes import SETS, contact_code, in_contact, is_stick, set_of
 
@@ -70,8 +74,15 @@ MAX_NEWTON = 15
 FD_REL = 1e-6
 #: The integrator's tolerance for the period map (tighter than the Newton tolerance by 100).
 MAP_TOL = 1e-9
-#: The monodromy again with CHECK_STEP times the step: the multipliers' error estimate.
-CHECK_STEP = 10.0
+#: The variational equations' tolerance on the error scales.  Measured on the period map at
+#: 200 N from a 30-period run: the multipliers at 1e-6 are within 4e-6 of those at 1e-7 at
+#: 45 Hz and 1e-7 at 20 Hz, at 855 and 1198 steps (the run's own: 804 and 1313); at 1e-7 the
+#: forward-differenced Jacobian's noise makes 45 Hz take 4292.
+VAR_TOL = 1e-6
+#: The monodromy again with CHECK_FACTOR times the tolerance or the finite-difference step:
+#: the multipliers' error estimate.
+CHECK_FACTOR = 10.0
+
 #: |multiplier| below 1 - max(STABLE_MARGIN, its error) is stable, above 1 + that unstable.
 STABLE_MARGIN = 1e-6
 #: A multiplier this close to 1 moving the body's tangential position is the friction-held
@@ -113,6 +124,7 @@ class Orbit:
     tip_rms_cm: float = float("nan")
     multiplier_error: float = float("nan")   # the multipliers' error estimate (module docstring)
     phase: float = 0.0                # the section's drive phase (fraction of a period)
+    monodromy_method: str = "variational"   # how the monodromy was taken (module docstring)
 
     def deciding(self) -> np.ndarray:
         """The multipliers that decide the stability: all but the neutral one."""
@@ -136,7 +148,7 @@ class Orbit:
                 "phase": self.phase,
                 **self.responses, "wall_s": self.wall_s,
                 "regime": self.regime, "contact_code": int(contact_code(self.regime)),
-                "dimension": self.dimension, "monodromy": "finite-difference",
+                "dimension": self.dimension, "monodromy": self.monodromy_method,
                 "neutral_multiplier": (None if self.neutral is None
                                        else [self.neutral.real, self.neutral.imag]),
                 "residual_history": self.history, "state": self.state.tolist()}
@@ -230,6 +242,11 @@ class Manifold:
         """The reduced coordinates of a state difference dx."""
         return np.concatenate([self.Nq.T @ dx[:ly.N_DOF], self.Nv.T @ dx[ly.N_DOF:]])
 
+    def basis(self, x) -> np.ndarray:
+        """The full state's change (N_STATE x dim) per unit of each reduced coordinate at x
+        (:meth:`move` is linear in z)."""
+        return np.column_stack([self.move(x, z) - x for z in np.eye(self.dim)])
+
     def project(self, x):
         """x back onto the manifold: the closed gaps to zero (Gauss-Newton in the normal
         rows' span), then the rates onto W q' = 0."""
@@ -266,13 +283,18 @@ class Shooter:
     continuation)."""
 
     def __init__(self, params: Parameters, drive, periods: int = 1, fixed=(),
-                 parameter: str | None = None):
+                 parameter: str | None = None, monodromy: str = "variational"):
         if not isinstance(params, Parameters):
             raise ParameterError(f"params must be Parameters, got {type(params).__name__}")
         if not isinstance(periods, (int, np.integer)) or isinstance(periods, bool) or periods < 1:
             raise ParameterError(f"periods = {periods!r}: a whole number of drive periods, >= 1")
         if parameter not in (None, "freq_hz", "force_n"):
             raise ParameterError(f"parameter = {parameter!r}: allowed freq_hz, force_n")
+        if monodromy not in MONODROMY_METHODS:
+            raise ParameterError(f"monodromy = {monodromy!r}: allowed "
+                                 f"{', '.join(MONODROMY_METHODS)}")
+        self.method = monodromy
+        self.fallback = ""        # why the last monodromy was not variational, if it was not
         self.params, self.periods, self.fixed, self.parameter = params, int(periods), fixed, parameter
         self.ex, _ = sine_of(drive)
         model = mdl.build(params, fixed=fixed)
@@ -337,7 +359,33 @@ class Shooter:
         return (record, res, scale, float(np.max(np.abs(res) / scale)),
                 int(record.signal("regime")[-1]))
 
-    def monodromy(self, manifold, x, regime, ex, scale, rel: float = FD_REL) -> np.ndarray:
+    def monodromy(self, manifold, x, regime, ex, record, scale, check: bool = False
+                  ) -> tuple[np.ndarray, str]:
+        """(J, method): the K-period map's Jacobian in the reduced coordinates, along
+        ``record`` (the map's run from x) by the variational equations and saltation
+        matrices, or by finite differences (module docstring; ``self.fallback`` says why
+        where the variational equations were asked for).  ``check``: the error estimate's
+        coarser monodromy (CHECK_FACTOR times the tolerance or the step)."""
+        from .monodromy import MonodromyError, variational_monodromy
+        factor = CHECK_FACTOR if check else 1.0
+        if self.method == "variational":
+            try:
+                if record.stats["stepped_steps"]:
+                    raise MonodromyError("the run took Moreau-Jean steps (an event flood)")
+                dt, _ = lattice(self.params, ex, 1.0 / float(ex[cx.X_FREQ]))
+                M = variational_monodromy(self.params, ex, x, regime, self.t0(ex),
+                                          self.period_s(ex), record.log, manifold.basis(x),
+                                          scale, factor * VAR_TOL, dt, self.fixed,
+                                          factor * VAR_FD_REL)
+                self.fallback = ""
+                return np.column_stack([manifold.coordinates(v) for v in M.matrix.T]), \
+                    "variational"
+            except MonodromyError as exc:
+                self.fallback = f"finite differences: the variational equations failed ({exc})"
+        return self.fd_monodromy(manifold, x, regime, ex, scale, factor * FD_REL), \
+            "finite-difference"
+
+    def fd_monodromy(self, manifold, x, regime, ex, scale, rel: float = FD_REL) -> np.ndarray:
         """The K-period map's Jacobian in the reduced coordinates, by central differences of
         ``rel`` of the error scales."""
         J = np.empty((manifold.dim, manifold.dim))
@@ -370,7 +418,7 @@ class Shooter:
         except ParameterError as exc:
             return _failed(str(exc), self.period_s(ex), self.periods, t_wall)
         history, status, message = [], "not converged", f"no fixed point in {max_newton} steps"
-        iterations, J, record = 0, None, None
+        iterations, J, record, method = 0, None, None, self.method
         try:
             for iterations in range(1, max_newton + 1):
                 manifold = self.manifold(x, regime)
@@ -382,7 +430,7 @@ class Shooter:
                                "iterate is not near an orbit of this regime")
                     x, regime = record.states[-1, :ly.N_STATE].copy(), end_regime  # on a period
                     continue
-                J = self.monodromy(manifold, x, regime, ex, scale)
+                J, method = self.monodromy(manifold, x, regime, ex, record, scale)
                 if residual <= newton_tol:
                     status, message = "ok", "found"
                     break
@@ -391,7 +439,8 @@ class Shooter:
                 x = self._damped(manifold, x, regime, ex, step, residual)
         except ParameterError as exc:
             return _failed(str(exc), self.period_s(ex), self.periods, t_wall)
-        return self.orbit(x, regime, ex, record, J, history, iterations, status, message, t_wall)
+        return self.orbit(x, regime, ex, record, J, history, iterations, status, message, t_wall,
+                          method)
 
     def _damped(self, manifold, x, regime, ex, step, residual):
         """x moved by the Newton step, halved (at most BACKTRACK times) while the residual
@@ -405,7 +454,7 @@ class Shooter:
         return manifold.project(manifold.move(x, step))
 
     def orbit(self, x, regime, ex, record, J, history, iterations, status, message,
-              t_wall) -> "Orbit":
+              t_wall, method: str = "variational") -> "Orbit":
         """The :class:`Orbit` at a solution (or the last iterate) with its multipliers and the
         facts of its record."""
         T = self.period_s(ex)
@@ -421,7 +470,7 @@ class Shooter:
         stable = None
         if status == "ok":
             scale = error_scales(self.P, record.states)
-            coarse = self.monodromy(manifold, x, regime, ex, scale, CHECK_STEP * FD_REL)
+            coarse, _ = self.monodromy(manifold, x, regime, ex, record, scale, check=True)
             error = multiplier_error(J, coarse)
             others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
             largest = others.max(initial=0.0)
@@ -433,13 +482,14 @@ class Shooter:
                 message = (f"found; stability undetermined: the largest |multiplier| "
                            f"{largest:.6f} is within the monodromy's error {error:.1e} of 1")
         message += f" (section at phase {self.phase:g} of the drive period)" if self.phase else ""
+        message += f"; monodromy by {self.fallback}" if method != self.method else ""
         return Orbit(status, message, T, self.periods, x, regime,
                      history[-1] if history else np.inf, iterations, multipliers, stable,
                      facts["grazing"], facts["min_open_gap_cm"], facts["events_per_period"],
                      facts["contact_time_share"], facts["tip_amplitude_cm"],
                      time.perf_counter() - t_wall, manifold.dim, history,
                      None if neutral is None else complex(multipliers[neutral]), J,
-                     facts["responses"], facts["tip_rms_cm"], error, self.phase)
+                     facts["responses"], facts["tip_rms_cm"], error, self.phase, method)
 
 
 def multiplier_error(J: np.ndarray, other: np.ndarray) -> float:
@@ -451,7 +501,7 @@ def multiplier_error(J: np.ndarray, other: np.ndarray) -> float:
 
 def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
                    newton_tol: float = 1e-7, max_newton: int = MAX_NEWTON,
-                   fixed=(), phases=PHASES) -> Orbit:
+                   fixed=(), phases=PHASES, monodromy: str = "variational") -> Orbit:
     """A periodic orbit of ``periods`` drive periods (module docstring).
 
     ``drive``: a sine (``drives.sine(force_n, freq_hz)`` or its settings; the soft start is
@@ -459,10 +509,11 @@ def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
     default the state after GUESS_PERIODS periods from the static equilibrium.  The section
     is taken at the drive phases ``phases`` in turn (fractions of a period) until one gives
     an orbit.  Returns an :class:`Orbit` whose ``status`` says whether it was found; never
-    one it did not find.
+    one it did not find.  ``monodromy``: "variational" or "finite-difference" (module
+    docstring).
     """
     t_wall = time.perf_counter()
-    shooter = Shooter(params, drive, periods, fixed)
+    shooter = Shooter(params, drive, periods, fixed, monodromy=monodromy)
     orbit = None
     for k, phase in enumerate(phases):
         shooter.phase = float(phase)

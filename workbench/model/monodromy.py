@@ -1,0 +1,143 @@
+"""The Jacobian of the period map by the variational equations and saltation matrices.
+
+Along a run of the period map (a record of :func:`workbench.model.simulate.simulate`, with its
+event log), :func:`variational_monodromy` integrates the state again with the variational
+equations of each regime between events (:func:`workbench.core.variational.variational_span`)
+and multiplies in the saltation matrix of each event of the log
+(:func:`workbench.core.variational.saltation`): impacts by Moreau's law, separations,
+stick -> slip and slip -> stick, each with the jump the integrator applies.  Each event is
+found again on this integration, its time corrected by Newton's method on its event
+function (to EVENT_TIME_TOL) from the logged time; the regime after it is the one the
+record's run chose (where the enumeration at this run's state, which differs from the
+record's by the tolerances, chooses another, as it may at a separating force of
+-LAMBDA_EPS: ``followed``).
+
+The variational equations carry the images of given tangent vectors of the start's regime
+(the orbit's reduced coordinates, :mod:`workbench.model.orbit`): M B, M = d y(t0 + T) /
+d y(t0), each column staying on the constraints of the regime it is in.  Runs with
+Moreau-Jean steps (an event flood) have no saltation matrices: MonodromyError.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core import layout as ly
+from ..core import variational as vr
+from ..core.config import EVENT_TIME_TOL, VAR_FD_REL
+from ..core.hybrid import begin
+from . import kernel_loading
+from . import packing as mdl
+from .methods import METHODS
+from .regimes import is_stick, set_of
+from .step_policy import stepped_dt
+from .tableaus import write_tableau
+
+#: Newton corrections of an event's time on the variational run, at most.
+EVENT_NEWTON = 4
+#: The method the variational equations are integrated with.
+METHOD = "dop853"
+
+
+class MonodromyError(RuntimeError):
+    """The variational run could not follow the record (the message says where)."""
+
+
+@dataclass
+class Monodromy:
+    """M B, M = dy(t0 + T)/dy(t0), B the tangent vectors it was asked for, and what its
+    integration took."""
+
+    matrix: np.ndarray       # N_STATE x n
+    end: np.ndarray          # the variational run's state at t0 + T (N_STATE)
+    steps: int
+    rejected: int
+    events: int
+    kinds: dict              # events by kind through which saltation matrices were taken
+    followed: int            # events whose regime after was taken from the record
+
+
+def event_index(kind: int, point: int) -> int:
+    """The event function (layout EV_*) of a log row's kind and point (1..4)."""
+    if kind == ly.KIND_IMPACT:
+        return ly.EV_GAP + point - 1
+    if kind == ly.KIND_SEPARATION:
+        return ly.EV_LAMBDA + point - 1
+    if kind == ly.KIND_STICK_SLIP:
+        return ly.EV_STICK
+    if kind == ly.KIND_SLIP_STICK:
+        return ly.EV_SLIP
+    raise ValueError(f"no event function for log kind {kind}")
+
+
+def _check(status: int, where: str) -> None:
+    if status != ly.OK:
+        raise MonodromyError(f"{where}: {ly.MESSAGES.get(status, status)}")
+
+
+def variational_monodromy(params, ex: np.ndarray, x: np.ndarray, regime: int, t0: float,
+                          period_s: float, log: np.ndarray, basis: np.ndarray,
+                          scale: np.ndarray, tol: float, h0: float, fixed=(),
+                          fd_rel: float = VAR_FD_REL) -> Monodromy:
+    """M B over [t0, t0 + period_s] from (x, regime) along the record whose event log is
+    ``log`` (rows LOG_*), B = ``basis`` (N_STATE x n) tangent vectors of the regime's
+    constraints at x; ``scale`` the error scales (N_STATE), ``tol`` the variational run's
+    tolerance on them, ``h0`` (s) its first step, ``fd_rel`` the state Jacobian's
+    difference step on the scales."""
+    kernel_loading.prepare_kernels(METHODS[METHOD].kernel)
+    model = mdl.build(params, fixed)
+    model.P[ly.P_STEPPED_DT] = stepped_dt(params)
+    write_tableau(model.P, METHODS[METHOD].tableau)
+    work, vw = mdl.make_work(), vr.make_var_work()
+    vw.scale[:] = scale
+    vw.ctl[vr.CTL_H] = h0
+    vw.ctl[vr.CTL_FD_REL] = fd_rel
+    st = np.zeros(ly.N_ST)
+    work.rg[ly.RG_SET] = set_of(regime)
+    work.rg[ly.RG_STICK] = 1.0 if is_stick(regime) else 0.0
+    work.rg[ly.RG_SIGN] = 1.0
+    work.stages[ly.STAGE_CUR, :ly.N_STATE] = x[:ly.N_STATE]
+    status, _, _ = begin(float(t0), np.int64(0), model, ex, work, np.empty(1),
+                         np.empty((1, ly.N_STATE)), np.empty((1, ly.N_SIG)),
+                         np.empty((1, ly.N_LOG)), st)
+    _check(status, "the start")
+    y = work.stages[ly.STAGE_CUR].copy()
+    ncol = basis.shape[1]
+    phi = np.zeros((ly.N_STATE, ly.N_STATE))
+    phi[:, :ncol] = basis
+    vw.column[:ncol] = np.maximum(np.abs(basis / scale[:, None]).max(axis=0), 1e-300)
+    t, kinds = float(t0), {}
+    rows = [r for r in log if int(r[ly.LOG_KIND]) != ly.KIND_START]
+    for n, row in enumerate(rows):
+        kind, point = int(row[ly.LOG_KIND]), int(row[ly.LOG_POINT])
+        e = event_index(kind, point)
+        where = f"event {n + 1} ({ly.EVENT_KINDS[kind]}, point {point}) at t = {row[ly.LOG_T]:.9f} s"
+        _check(vr.variational_span(t, float(row[ly.LOG_T]), tol, y, phi, model, ex, work, vw),
+               where)
+        t = float(row[ly.LOG_T])
+        for _ in range(EVENT_NEWTON):       # the event's time on this run
+            status, value, rate = vr.event_rate(e, t, y, vw.f_minus, model, ex, work, vw) \
+                if _rhs(t, y, model, ex, work, vw) == ly.OK else (ly.ERR_NAN, 0.0, 0.0)
+            _check(status, where)
+            dt = -value / rate if rate != 0.0 else 0.0
+            if abs(dt) <= EVENT_TIME_TOL:
+                break
+            _check(vr.variational_span(t, t + dt, tol, y, phi, model, ex, work, vw), where)
+            t += dt
+        _check(vr.saltation(e, t, y, st, np.int64(row[ly.LOG_TO]), model, ex, work, vw, phi,
+                            np.int64(ncol)), where)
+        y[:] = vw.y_plus
+        st[:] = vw.st_plus
+        kinds[ly.EVENT_KINDS[kind]] = kinds.get(ly.EVENT_KINDS[kind], 0) + 1
+    _check(vr.variational_span(t, t0 + period_s, tol, y, phi, model, ex, work, vw),
+           "the last span")
+    return Monodromy(phi[:, :ncol].copy(), y[:ly.N_STATE].copy(), int(vw.ctl[vr.CTL_STEPS]),
+                     int(vw.ctl[vr.CTL_REJECTED]), len(rows), kinds,
+                     int(vw.ctl[vr.CTL_FOLLOWED]))
+
+
+def _rhs(t, y, model, ex, work, vw) -> int:
+    """f(t, y) of the current regime into vw.f_minus."""
+    from ..core.constrained import rhs_regime
+    return rhs_regime(t, y, model, ex, work, vw.f_minus)
