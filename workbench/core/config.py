@@ -178,6 +178,6 @@ JUMP_FD_REL = 1e-6
 #: (central differences; the fastest mode, ~6 kHz, moves by 4e-5 rad in it).
 EVENT_DT_FD_S = 1e-9
 #: The variational equations' step (s) at most, and its floor: the run's own
-#: steps are 2e-5..1e-4 s; a step below the floor is a failure (ERR_STEP_FLOOR).
+#: steps are 2e-5..1e-4 s; a step below the floor is a failure (ERR_VAR_STEPS).
 VAR_H_MAX_S = 1e-3
 VAR_H_MIN_S = 1e-12

@@ -117,7 +117,8 @@ LOG_FULL = 7     # not an error: the event log is full, call again to continue
 STOPPED = 8      # not a kernel's: simulate(stop=...) ended the run early, as asked
 ERR_JUMP_AMBIGUOUS = 9   # an event's outcome changes within the differencing step (core.variational)
 ERR_EVENT_TANGENT = 10   # the orbit meets the event surface tangentially: dh/dt = 0 (core.variational)
-ERR_STEP_FLOOR = 11      # the variational equations' step fell below its floor (core.variational)
+ERR_VAR_STEPS = 11       # the variational equations' step fell below its floor, or they took
+                         # more steps than allowed (core.variational)
 
 MESSAGES = {
     OK: "finished",
@@ -134,7 +135,8 @@ MESSAGES = {
                         "differencing step: the jump is not differentiable there",
     ERR_EVENT_TANGENT: "the orbit meets an event surface tangentially (dh/dt = 0): no "
                        "saltation matrix",
-    ERR_STEP_FLOOR: "the variational equations' step fell below its floor",
+    ERR_VAR_STEPS: "the variational equations' step fell below its floor or far below the "
+                   "run's (more steps than allowed)",
 }
 
 # --- status codes of the static equilibrium (workbench.core.equilibrium) -------

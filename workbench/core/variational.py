@@ -50,9 +50,10 @@ from .transitions import arm_gaps
 VarWork = namedtuple("VarWork", "K A phi_stage phi_new y_new y_fd f_fd f_minus f_plus y_plus "
                                 "grad rg_minus rg_plus st st_plus log scale column ctl")
 #: ctl entries: the step (s), steps accepted, steps rejected, events whose regime after was
-#: the target's, not the enumeration's (:func:`saltation`), and the state Jacobian's
-#: forward-difference step relative to the error scales (default VAR_FD_REL).
-CTL_H, CTL_STEPS, CTL_REJECTED, CTL_FOLLOWED, CTL_FD_REL = 0, 1, 2, 3, 4
+#: the target's, not the enumeration's (:func:`saltation`), the state Jacobian's
+#: forward-difference step relative to the error scales (default VAR_FD_REL), and the steps
+#: (accepted and rejected) allowed in all (ERR_VAR_STEPS beyond).
+CTL_H, CTL_STEPS, CTL_REJECTED, CTL_FOLLOWED, CTL_FD_REL, CTL_MAX_STEPS = 0, 1, 2, 3, 4, 5
 N = ly.N_STATE
 
 
@@ -66,7 +67,7 @@ def make_var_work() -> VarWork:
                    rg_minus=np.zeros(ly.N_RG), rg_plus=np.zeros(ly.N_RG), st=np.zeros(ly.N_ST),
                    st_plus=np.zeros(ly.N_ST), log=np.zeros((2, ly.N_LOG)), scale=np.ones(N),
                    column=np.ones(N),
-                   ctl=np.array([0.0, 0.0, 0.0, 0.0, VAR_FD_REL]))
+                   ctl=np.array([0.0, 0.0, 0.0, 0.0, VAR_FD_REL, np.inf]))
 
 
 @nb.njit(**JIT)
@@ -199,7 +200,8 @@ def variational_span(t, t_end, tol, y, Phi, model, ex, work, vw):
 
     Steps of the pair in P controlled to ``tol`` (the error estimate's largest ratio to
     the scales, :func:`variational_step`), starting from vw.ctl[CTL_H] and leaving the
-    last full step there.  Returns a status."""
+    last full step there; ERR_VAR_STEPS below VAR_H_MIN_S or past vw.ctl[CTL_MAX_STEPS].
+    Returns a status."""
     P, stages, K, ctl = model.P, work.stages, vw.K, vw.ctl
     s = int(P[ly.P_RK_STAGES])
     if t_end == t:
@@ -238,8 +240,8 @@ def variational_span(t, t_end, tol, y, Phi, model, ex, work, vw):
             ctl[CTL_REJECTED] += 1.0
         factor = 5.0 if ratio == 0.0 else min(5.0, max(0.2, 0.9 * ratio ** exponent))
         h = min(h_try * factor, VAR_H_MAX_S)
-        if h < VAR_H_MIN_S:
-            return ly.ERR_STEP_FLOOR
+        if h < VAR_H_MIN_S or ctl[CTL_STEPS] + ctl[CTL_REJECTED] > ctl[CTL_MAX_STEPS]:
+            return ly.ERR_VAR_STEPS
     ctl[CTL_H] = h
     return ly.OK
 

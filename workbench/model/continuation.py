@@ -248,8 +248,8 @@ def _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds):
 
 def branch_rows(branch: Branch) -> list[dict]:
     """One row per orbit (CGS like the points table): the parameter, the orbit's responses,
-    contact shares, events per period, the largest multiplier's modulus, ``stable`` and the
-    ``bifurcation`` between it and the one before."""
+    contact shares, events per period, the largest multiplier's modulus, how the monodromy
+    was taken, ``stable`` and the ``bifurcation`` between it and the one before."""
     kinds = dict(branch.bifurcations)
     rows = []
     for i, (value, orbit) in enumerate(branch.orbits):
@@ -262,6 +262,7 @@ def branch_rows(branch: Branch) -> list[dict]:
                   for k, v in orbit.events_per_period.items()},
                "max_multiplier": float(np.abs(deciding).max(initial=0.0)),
                "multiplier_error": orbit.multiplier_error,
+               "monodromy": orbit.monodromy_method,
                "stable": orbit.stable is True,
                "stability": {True: "stable", False: "unstable", None: "undetermined"}[
                    orbit.stable],

@@ -376,7 +376,8 @@ class Shooter:
                 M = variational_monodromy(self.params, ex, x, regime, self.t0(ex),
                                           self.period_s(ex), record.log, manifold.basis(x),
                                           scale, factor * VAR_TOL, dt, self.fixed,
-                                          factor * VAR_FD_REL)
+                                          factor * VAR_FD_REL,
+                                          int(record.control.get("steps_all", 0)))
                 self.fallback = ""
                 return np.column_stack([manifold.coordinates(v) for v in M.matrix.T]), \
                     "variational"

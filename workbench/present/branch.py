@@ -76,8 +76,10 @@ def write_branch(branch: Branch, out: Path, params) -> None:
              f"{int((table.stability == 'undetermined').sum()) if len(table) else 0} of "
              f"stability undetermined (a multiplier within its error of 1), in "
              f"{branch.wall_s:.0f} s (pseudo-arclength "
-             "continuation, `workbench/model/continuation.py`; multipliers from the "
-             "finite-difference monodromy).", ""]
+             "continuation, `workbench/model/continuation.py`; the monodromy "
+             + (", ".join(f"{m} for {n} orbits" for m, n in
+                          table.monodromy.value_counts().items()) if len(table) else "none")
+             + ").", ""]
     if branch.bifurcations:
         lines += ["| at | kind |", "|---|---|"]
         lines += [f"| {table[branch.parameter].iloc[i]:.5g} | {kind} |"
