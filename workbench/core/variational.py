@@ -28,17 +28,15 @@ differences (JUMP_FD_REL of the error scales), dh/dt along f- over EVENT_DT_FD_S
 differentiable there (ERR_JUMP_AMBIGUOUS); an event met tangentially has no saltation
 matrix (ERR_EVENT_TANGENT).
 
-The scratch is a :data:`VarWork` record (:func:`make_var_work`); ``scale`` its error scales
+The scratch is a ``VarWork`` record (:func:`workbench.model.monodromy.make_var_work`); ``scale`` its error scales
 (N_STATE), ``column`` each column's size on them, ``ctl`` the step (CTL_H), steps taken (CTL_STEPS) and rejected (CTL_REJECTED).
 """
 import math
-from collections import namedtuple
-
 import numba as nb
 import numpy as np
 
-from .config import (EVENT_DT_FD_S, JIT, JIT_INLINE, JUMP_FD_REL, RATE_EPS, VAR_FD_REL,
-                     VAR_H_MAX_S, VAR_H_MIN_S)
+from .config import (EVENT_DT_FD_S, JIT, JIT_INLINE, JUMP_FD_REL, RATE_EPS, VAR_H_MAX_S,
+                     VAR_H_MIN_S)
 from . import layout as ly
 from .constrained import project, rhs_regime, tangent_point
 from .contact import fill_geometry, regime_of, row_rate
@@ -47,27 +45,13 @@ from .hybrid import apply_event, event_transition
 from .integrate import stage_state
 from .transitions import arm_gaps
 
-VarWork = namedtuple("VarWork", "K A phi_stage phi_new y_new y_fd f_fd f_minus f_plus y_plus "
-                                "grad rg_minus rg_plus st st_plus log scale column ctl")
 #: ctl entries: the step (s), steps accepted, steps rejected, events whose regime after was
 #: the target's, not the enumeration's (:func:`saltation`), the state Jacobian's
 #: forward-difference step relative to the error scales (default VAR_FD_REL), and the steps
 #: (accepted and rejected) allowed in all (ERR_VAR_STEPS beyond).
 CTL_H, CTL_STEPS, CTL_REJECTED, CTL_FOLLOWED, CTL_FD_REL, CTL_MAX_STEPS = 0, 1, 2, 3, 4, 5
+N_CTL = 6
 N = ly.N_STATE
-
-
-def make_var_work() -> VarWork:
-    """Fresh scratch for one thread of variational kernel calls."""
-    return VarWork(K=np.zeros((ly.MAX_RK_STAGES, N, N)), A=np.zeros((N, N)),
-                   phi_stage=np.zeros((N, N)), phi_new=np.zeros((N, N)),
-                   y_new=np.zeros(ly.N_AUG), y_fd=np.zeros(ly.N_AUG), f_fd=np.zeros(ly.N_AUG),
-                   f_minus=np.zeros(ly.N_AUG), f_plus=np.zeros(ly.N_AUG),
-                   y_plus=np.zeros(ly.N_AUG), grad=np.zeros(N),
-                   rg_minus=np.zeros(ly.N_RG), rg_plus=np.zeros(ly.N_RG), st=np.zeros(ly.N_ST),
-                   st_plus=np.zeros(ly.N_ST), log=np.zeros((2, ly.N_LOG)), scale=np.ones(N),
-                   column=np.ones(N),
-                   ctl=np.array([0.0, 0.0, 0.0, 0.0, VAR_FD_REL, np.inf]))
 
 
 @nb.njit(**JIT)

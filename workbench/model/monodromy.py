@@ -19,6 +19,7 @@ Moreau-Jean steps (an event flood) have no saltation matrices: MonodromyError.
 """
 from __future__ import annotations
 
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +43,28 @@ METHOD = "dop853"
 #: record's run (measured: 1.1 at 20 Hz, 1.4 at 45 Hz), and beyond that at least.
 STEPS_PER_RUN_STEP = 10
 MIN_STEPS = 2000
+
+
+#: Scratch of the variational kernels (:mod:`workbench.core.variational`): stage matrices K,
+#: the state Jacobian A, Phi's stage and next values, state buffers, the jump's regime records
+#: and statistics, a log row, the error scales, each column's size, and ctl (CTL_*).
+VarWork = namedtuple("VarWork", "K A phi_stage phi_new y_new y_fd f_fd f_minus f_plus y_plus "
+                                "grad rg_minus rg_plus st st_plus log scale column ctl")
+
+
+def make_var_work() -> VarWork:
+    """Fresh scratch for one thread of variational kernel calls."""
+    n = ly.N_STATE
+    ctl = np.zeros(vr.N_CTL)
+    ctl[vr.CTL_FD_REL], ctl[vr.CTL_MAX_STEPS] = VAR_FD_REL, np.inf
+    return VarWork(K=np.zeros((ly.MAX_RK_STAGES, n, n)), A=np.zeros((n, n)),
+                   phi_stage=np.zeros((n, n)), phi_new=np.zeros((n, n)),
+                   y_new=np.zeros(ly.N_AUG), y_fd=np.zeros(ly.N_AUG), f_fd=np.zeros(ly.N_AUG),
+                   f_minus=np.zeros(ly.N_AUG), f_plus=np.zeros(ly.N_AUG),
+                   y_plus=np.zeros(ly.N_AUG), grad=np.zeros(n),
+                   rg_minus=np.zeros(ly.N_RG), rg_plus=np.zeros(ly.N_RG), st=np.zeros(ly.N_ST),
+                   st_plus=np.zeros(ly.N_ST), log=np.zeros((2, ly.N_LOG)), scale=np.ones(n),
+                   column=np.ones(n), ctl=ctl)
 
 
 class MonodromyError(RuntimeError):
@@ -95,7 +118,7 @@ def variational_monodromy(params, ex: np.ndarray, x: np.ndarray, regime: int, t0
     model = mdl.build(params, fixed)
     model.P[ly.P_STEPPED_DT] = stepped_dt(params)
     write_tableau(model.P, METHODS[METHOD].tableau)
-    work, vw = mdl.make_work(), vr.make_var_work()
+    work, vw = mdl.make_work(), make_var_work()
     vw.scale[:] = scale
     vw.ctl[vr.CTL_H] = h0
     vw.ctl[vr.CTL_FD_REL] = fd_rel
