@@ -5,11 +5,12 @@ obeys dPhi/dt = A(t) Phi, A = df/dy of the regime's right-hand side
 (:func:`workbench.core.constrained.rhs_regime`).  The model has no analytic Jacobian: A
 is taken by forward differences of f, a step of VAR_FD_REL (or ctl[CTL_FD_REL]) of each
 component's error scale (the kinematic rows, dq'/dy, exactly; a held coordinate's rows
-and columns are 0).  :func:`variational_span` integrates (y, Phi) together with the pair in P (the run's method): stage r's Phi_r = Phi + h sum_j a_rj K_j
-and K_r = A(t_r, y_r) Phi_r, so that Phi is the Jacobian of the method's own step; the
-step is controlled on both error estimates (y on its error scales, Phi_ik on scale_i
-times column k's size at the start), and y is projected onto the regime's constraints after each step, as
-the run's steps are (:func:`workbench.core.pair.pair_step`).
+and columns are 0).  :func:`variational_span` integrates (y, Phi) together with the pair
+in P (the run's method): stage r's Phi_r = Phi + h sum_j a_rj K_j and
+K_r = A(t_r, y_r) Phi_r, so that Phi is the Jacobian of the method's own step; the step is
+controlled on both error estimates (y on its error scales, Phi_ik on scale_i times column
+k's size at the start), and y is projected onto the regime's constraints after each step,
+as the run's steps are (:func:`workbench.core.pair.pair_step`).
 
 At an event at time t_e, with event function h(t, y) (:mod:`workbench.core.event_functions`)
 and jump y+ = G(y-) (:func:`workbench.core.hybrid.apply_event`: the projection onto the
@@ -23,13 +24,16 @@ f- the old regime's right-hand side at y-, f+ the new one's at y+, and dh/dt = h
 Bifurcations of Non-Smooth Mechanical Systems*, LNACM 18, Springer 2004, §3.5; Müller,
 Chaos, Solitons & Fractals 5(9), 1995).  S is applied to the columns of Phi, each a
 tangent vector of the regime's constraints: G_y and grad h along each by central
-differences (JUMP_FD_REL of the error scales), dh/dt along f- over EVENT_DT_FD_S.  A jump whose outcome
-(the regime, its slip direction) changes within the differencing step is not
-differentiable there (ERR_JUMP_AMBIGUOUS); an event met tangentially has no saltation
-matrix (ERR_EVENT_TANGENT).
+differences (JUMP_FD_REL of the error scales), dh/dt along f- over EVENT_DT_FD_S; G with
+the regime after the event held (:func:`forced_jump`: a perturbed state meets the same
+transition).  Where the enumeration's choice differs from the jump with that regime held
+(an impulse resolved an inconsistent state) the jump is not differentiable
+(ERR_JUMP_AMBIGUOUS); an event met tangentially has no saltation matrix
+(ERR_EVENT_TANGENT).
 
-The scratch is a ``VarWork`` record (:func:`workbench.model.monodromy.make_var_work`); ``scale`` its error scales
-(N_STATE), ``column`` each column's size on them, ``ctl`` the step (CTL_H), steps taken (CTL_STEPS) and rejected (CTL_REJECTED).
+The scratch is a ``VarWork`` record (:func:`workbench.model.monodromy.make_var_work`):
+``scale`` its error scales (N_STATE), ``column`` each column's size on them, ``ctl`` the
+step and counts (CTL_*).
 """
 import math
 import numba as nb

@@ -12,8 +12,8 @@ method on
 
 its Jacobian [[J - I, dR/dlambda], [t0]] (J the monodromy of :mod:`workbench.model.orbit`,
 by finite differences of the map where the variational one is poor (POOR), dR/dlambda by
-central differences of the map, two more integrations).  The step ds grows by GROW after a corrector of at most EASY iterations,
-halves after a failed one (a corrector that does not converge in MAX_CORRECTOR iterations,
+central differences of the map, two more integrations).  The step ds grows by GROW after
+a corrector of at most EASY iterations, halves after a failed one (a corrector that does not converge in MAX_CORRECTOR iterations,
 or a new orbit farther than JUMP x ds from the last: a jump to another branch).  Where the
 orbit's state at phase 0 passes an event along the branch (the period map ends in another
 regime than it starts from), the orbit at the predicted parameter is found by shooting

@@ -27,6 +27,7 @@ import numpy as np
 from ..core import layout as ly
 from ..core import variational as vr
 from ..core.config import EVENT_TIME_TOL, VAR_FD_REL
+from ..core.constrained import rhs_regime
 from ..core.hybrid import begin
 from . import kernel_loading
 from . import packing as mdl
@@ -142,13 +143,14 @@ def variational_monodromy(params, ex: np.ndarray, x: np.ndarray, regime: int, t0
     for n, row in enumerate(rows):
         kind, point = int(row[ly.LOG_KIND]), int(row[ly.LOG_POINT])
         e = event_index(kind, point)
-        where = f"event {n + 1} ({ly.EVENT_KINDS[kind]}, point {point}) at t = {row[ly.LOG_T]:.9f} s"
+        where = (f"event {n + 1} ({ly.EVENT_KINDS[kind]}, point {point}) at "
+                 f"t = {row[ly.LOG_T]:.9f} s")
         _check(vr.variational_span(t, float(row[ly.LOG_T]), tol, y, phi, model, ex, work, vw),
                where)
         t = float(row[ly.LOG_T])
         for _ in range(EVENT_NEWTON):       # the event's time on this run
-            status, value, rate = vr.event_rate(e, t, y, vw.f_minus, model, ex, work, vw) \
-                if _rhs(t, y, model, ex, work, vw) == ly.OK else (ly.ERR_NAN, 0.0, 0.0)
+            _check(rhs_regime(t, y, model, ex, work, vw.f_minus), where)
+            status, value, rate = vr.event_rate(e, t, y, vw.f_minus, model, ex, work, vw)
             _check(status, where)
             dt = -value / rate if rate != 0.0 else 0.0
             if abs(dt) <= EVENT_TIME_TOL:
@@ -165,9 +167,3 @@ def variational_monodromy(params, ex: np.ndarray, x: np.ndarray, regime: int, t0
     return Monodromy(phi[:, :ncol].copy(), y[:ly.N_STATE].copy(), int(vw.ctl[vr.CTL_STEPS]),
                      int(vw.ctl[vr.CTL_REJECTED]), len(rows), kinds,
                      int(vw.ctl[vr.CTL_FOLLOWED]))
-
-
-def _rhs(t, y, model, ex, work, vw) -> int:
-    """f(t, y) of the current regime into vw.f_minus."""
-    from ..core.constrained import rhs_regime
-    return rhs_regime(t, y, model, ex, work, vw.f_minus)

@@ -25,7 +25,8 @@ no saltation matrices (Moreau-Jean steps, an event met tangentially; the orbit's
 says so).  Its eigenvalues are the Floquet multipliers (the reduced system's; the
 constrained directions have none); the multipliers' error is estimated by the monodromy
 again at CHECK_FACTOR times the tolerance and the state Jacobian's difference step
-(variational) or the map's difference step (finite differences) (``multiplier_error``, the largest shift of a multiplier); the orbit is stable when every
+(variational) or the map's difference step (finite differences) (``multiplier_error``,
+the largest shift of a multiplier); the orbit is stable when every
 |multiplier| is below 1 by more than that, unstable when one is above 1 by more, and its
 stability undetermined (``stable`` null, the message says so) in between; all but the
 neutral one: where
@@ -54,9 +55,9 @@ import numpy as np
 
 from ..core import excitation as cx
 from ..core import layout as ly
+from ..core.config import VAR_FD_REL
 from ..core.contact import eval_geometry
 from . import packing as mdl
-from ..core.config import VAR_FD_REL
 from .limits import MONODROMY_METHODS
 from .params import ParameterError, Parameters
 from .regimes import SETS, contact_code, in_contact, is_stick, set_of
