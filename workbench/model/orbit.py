@@ -25,8 +25,9 @@ no saltation matrices (Moreau-Jean steps, an event met tangentially; the orbit's
 says so).  Its eigenvalues are the Floquet multipliers (the reduced system's; the
 constrained directions have none); the multipliers' error is estimated by the monodromy
 again at CHECK_FACTOR times the tolerance and the state Jacobian's difference step
-(variational) or the map's difference step (finite differences) (``multiplier_error``,
-the largest shift of a multiplier); the orbit is stable when every
+(variational; at a CHECK_FACTOR-th where that one is off by more than FINER_ABOVE) or the
+map's difference step (finite differences) (``multiplier_error``, the largest shift of a
+multiplier); the orbit is stable when every
 |multiplier| is below 1 by more than that, unstable when one is above 1 by more, and its
 stability undetermined (``stable`` null, the message says so) in between; all but the
 neutral one: where
@@ -81,8 +82,11 @@ MAP_TOL = 1e-9
 #: forward-differenced Jacobian's noise makes 45 Hz take 4292.
 VAR_TOL = 1e-6
 #: The monodromy again with CHECK_FACTOR times the tolerance or the finite-difference step:
-#: the multipliers' error estimate.
+#: the multipliers' error estimate; where that differs by more than FINER_ABOVE from the
+#: variational monodromy (the coarser run's own error: an event its steps place otherwise),
+#: the estimate is the difference from the one at a CHECK_FACTOR-th instead.
 CHECK_FACTOR = 10.0
+FINER_ABOVE = 1e-3
 
 #: |multiplier| below 1 - max(STABLE_MARGIN, its error) is stable, above 1 + that unstable.
 STABLE_MARGIN = 1e-6
@@ -360,15 +364,14 @@ class Shooter:
         return (record, res, scale, float(np.max(np.abs(res) / scale)),
                 int(record.signal("regime")[-1]))
 
-    def monodromy(self, manifold, x, regime, ex, record, scale, check: bool = False
+    def monodromy(self, manifold, x, regime, ex, record, scale, factor: float = 1.0
                   ) -> tuple[np.ndarray, str]:
         """(J, method): the K-period map's Jacobian in the reduced coordinates, along
         ``record`` (the map's run from x) by the variational equations and saltation
         matrices, or by finite differences (module docstring; ``self.fallback`` says why
-        where the variational equations were asked for).  ``check``: the error estimate's
-        coarser monodromy (CHECK_FACTOR times the tolerance or the step)."""
+        where the variational equations were asked for).  ``factor``: the tolerance and the
+        difference steps times that (the error estimate's other monodromy)."""
         from .monodromy import MonodromyError, variational_monodromy
-        factor = CHECK_FACTOR if check else 1.0
         if self.method == "variational":
             try:
                 if record.stats["stepped_steps"]:
@@ -472,8 +475,13 @@ class Shooter:
         stable = None
         if status == "ok":
             scale = error_scales(self.P, record.states)
-            coarse, _ = self.monodromy(manifold, x, regime, ex, record, scale, check=True)
+            coarse, _ = self.monodromy(manifold, x, regime, ex, record, scale, CHECK_FACTOR)
             error = multiplier_error(J, coarse)
+            if method == "variational" and error > FINER_ABOVE:
+                finer, how = self.monodromy(manifold, x, regime, ex, record, scale,
+                                            1.0 / CHECK_FACTOR)
+                if how == "variational":
+                    error = multiplier_error(J, finer)
             others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
             largest = others.max(initial=0.0)
             if largest < 1.0 - max(error, STABLE_MARGIN):
