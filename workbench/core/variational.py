@@ -243,23 +243,31 @@ def event_function(e, t, y, model, ex, work, f):
 
 
 @nb.njit(**JIT)
+def _difference(e, t, y, v, d, dt, model, ex, work, vw):
+    """(status, (h_e(t + dt, y + d v) - h_e(t - dt, y - d v)) / 2)."""
+    y_fd = vw.y_fd
+    for i in range(N):
+        y_fd[i] = y[i] + d * v[i]
+    status, hi = event_function(e, t + dt, y_fd, model, ex, work, vw.f_fd)
+    for i in range(N):
+        y_fd[i] = y[i] - d * v[i]
+    status2, lo = event_function(e, t - dt, y_fd, model, ex, work, vw.f_fd)
+    for i in range(N):
+        y_fd[i] = y[i]
+    if status != ly.OK or status2 != ly.OK:
+        return ly.ERR_NAN, 0.0
+    return ly.OK, 0.5 * (hi - lo)
+
+
+@nb.njit(**JIT)
 def event_rate(e, t, y, f, model, ex, work, vw):
     """(status, h_e(t, y), dh_e/dt along f): the event function and its total rate
     along the flow f (central differences over EVENT_DT_FD_S)."""
-    tau = EVENT_DT_FD_S
-    y_fd = vw.y_fd
     status, value = event_function(e, t, y, model, ex, work, vw.f_fd)
-    for i in range(N):
-        y_fd[i] = y[i] + tau * f[i]
-    status1, hi = event_function(e, t + tau, y_fd, model, ex, work, vw.f_fd)
-    for i in range(N):
-        y_fd[i] = y[i] - tau * f[i]
-    status2, lo = event_function(e, t - tau, y_fd, model, ex, work, vw.f_fd)
-    for i in range(N):
-        y_fd[i] = y[i]
-    if status != ly.OK or status1 != ly.OK or status2 != ly.OK:
+    status2, half = _difference(e, t, y, f, EVENT_DT_FD_S, EVENT_DT_FD_S, model, ex, work, vw)
+    if status != ly.OK or status2 != ly.OK:
         return ly.ERR_NAN, value, 0.0
-    return ly.OK, value, (hi - lo) / (2.0 * tau)
+    return ly.OK, value, half / EVENT_DT_FD_S
 
 
 @nb.njit(**JIT_INLINE)
@@ -320,18 +328,8 @@ def _slip_sign(y, set_index, P, cg, fallback):
 @nb.njit(**JIT)
 def _directional(e, t, y, v, d, model, ex, work, vw):
     """(status, dh_e/dy . v) by central differences of d along v."""
-    y_fd = vw.y_fd
-    for i in range(N):
-        y_fd[i] = y[i] + d * v[i]
-    status, hi = event_function(e, t, y_fd, model, ex, work, vw.f_fd)
-    for i in range(N):
-        y_fd[i] = y[i] - d * v[i]
-    status2, lo = event_function(e, t, y_fd, model, ex, work, vw.f_fd)
-    for i in range(N):
-        y_fd[i] = y[i]
-    if status != ly.OK or status2 != ly.OK:
-        return ly.ERR_NAN, 0.0
-    return ly.OK, (hi - lo) / (2.0 * d)
+    status, half = _difference(e, t, y, v, d, 0.0, model, ex, work, vw)
+    return status, half / d
 
 
 @nb.njit(**JIT)
