@@ -9,7 +9,8 @@ import pytest
 
 from workbench import cli
 from workbench.model import drives
-from workbench.model.continuation import Branch, _bifurcation, branch_rows, continue_branch
+from workbench.model.continuation import (Branch, _bifurcation, _tangent, branch_rows,
+                                          continue_branch)
 from workbench.model.orbit import Orbit, Shooter, periodic_orbit
 from workbench.model.params import Parameters
 from workbench.present.branch import write_branch
@@ -47,6 +48,9 @@ def test_each_orbit_of_the_branch_is_the_orbit_found_alone(stuck_branch):
     alone = periodic_orbit(Parameters(), drives.sine(0.5, value))
     assert alone.status == "ok"
     assert alone.tip_amplitude_cm == pytest.approx(orbit.tip_amplitude_cm, rel=1e-5)
+    # a linear response is a sine: its line at the drive frequency is half its range (the
+    # samples' peak misses the true one by 1 - cos(pi / 400) = 3e-5)
+    assert orbit.responses["tip_h1_cm"] == pytest.approx(orbit.tip_amplitude_cm, rel=1e-4)
     assert np.allclose(np.abs(alone.deciding()), np.abs(orbit.deciding()), atol=1e-5)
 
 
@@ -108,3 +112,33 @@ def test_the_continue_command_refuses_what_it_cannot_trace(tmp_path, capsys):
                      str(tmp_path / "b"), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["status"] == "done" and out["orbits"] >= 2 and out["parameter"] == "freq_hz"
+
+
+class _Plane:
+    """A stand-in manifold: reduced coordinates z move the state by B z (B: N x dim)."""
+
+    def __init__(self, B):
+        self.B, self.dim = B, B.shape[1]
+
+    def move(self, x, z):
+        return x + self.B @ z
+
+
+def test_the_tangent_keeps_its_direction_where_the_reduced_coordinates_change():
+    """The branch's tangent is oriented along the step from the orbit before (in the full
+    state), whatever the reduced coordinates: a branch whose regime at phase 0 changes (and
+    with it the coordinates' number and basis) goes on the way it came, not back towards the
+    range's direction.  Here the null vector of [J - I, dR] is (z, lambda) = (1, -1) (the
+    branch runs to lower lambda, past a fold): with a secant along it the tangent keeps
+    lambda decreasing, with the secant reversed it turns, and without one it points up the
+    range."""
+    x, scale, d = np.zeros(3), np.ones(3), np.ones(2)
+    J, dR = np.array([[2.0]]), np.array([1.0])        # (J - I) z + dR lambda = 0: z = -lambda
+    for B in (np.array([[1.0], [0.0], [0.0]]), np.array([[0.0], [0.0], [-1.0]])):
+        manifold = _Plane(B)
+        ahead = np.concatenate([B[:, 0], [-1.0]])      # the full-state step, lambda down
+        t = _tangent(J, dR, d, manifold, x, scale, ahead)
+        assert t[1] < 0 and t[0] > 0
+        t = _tangent(J, dR, d, manifold, x, scale, -ahead)
+        assert t[1] > 0
+        assert _tangent(J, dR, d, manifold, x, scale, None, direction=1.0)[1] > 0

@@ -19,6 +19,8 @@ def _cmd_sweep(args) -> int:
     check_output_dir("--results", args.results)
     if args.scheduler is not None:
         _check_scheduler(args.scheduler)
+    if study.continuation is not None:
+        return _branches(study, args)
     if args.dry_run:
         print(json_text(plan(study, args.results, fresh=args.fresh, jobs=args.jobs)))
         return EXIT_OK
@@ -33,6 +35,33 @@ def _cmd_sweep(args) -> int:
         summary["report"] = str(make_report(study, args.results, jobs=args.jobs))
     print(json_text(summary))
     return EXIT_OK if counts.get("ok", 0) == study.n_points else EXIT_POINTS_FAILED
+
+
+def _branches(study, args) -> int:
+    """``workbench sweep`` of a continuation study: its branches (study/branches.py)."""
+    import json
+    from ..study.branches import label, run_branches
+    if args.scheduler is not None:
+        raise ParameterError(f"--scheduler {args.scheduler}: a continuation study runs its "
+                             "branches on this machine's processes (--jobs)")
+    if args.dry_run:
+        print(json_text({"study": study.name, "branches": [label(p) for p in study.points],
+                         "jobs": min(args.jobs, study.n_points)}))
+        return EXIT_OK
+    from ..present.branch import write_branch, write_study_report
+    table = run_branches(study, write_branch, args.results, jobs=args.jobs, fresh=args.fresh,
+                         progress=not args.quiet)
+    out = Path(args.results) / study.name
+    write_study_report(study, out.resolve(), table, Path(args.results).resolve())
+    summaries = {label(p): json.loads((out / label(p) / "summary.json").read_text())
+                 for p in study.points}
+    ends = {k: s["status"] + (f", from the end {s['from_end']['status']}" if s["from_end"]
+                              else "") for k, s in summaries.items()}
+    print(json_text({"study": study.name, "branches": ends, "results": str(out),
+                     "report": str(out / "report.md")}))
+    covered = all(s["status"] == "done" or (s["from_end"] or {}).get("status") == "done"
+                  for s in summaries.values())
+    return EXIT_OK if covered else EXIT_POINTS_FAILED
 
 
 def _check_scheduler(address: str) -> None:
@@ -60,6 +89,12 @@ def _cmd_report(args) -> int:
     from ..study.definition import load
 
     study = load(args.study)
+    if study.continuation is not None:
+        from ..present.branch import write_study_report
+        from ..study.branches import collect
+        out = Path(args.results).resolve() / study.name
+        print(write_study_report(study, out, collect(study, out), Path(args.results).resolve()))
+        return EXIT_OK
     if not (Path(args.results) / study.name / "points.parquet").is_file():
         raise ParameterError(f"report {args.study}: no results in {Path(args.results) / study.name}"
                              f"; run `workbench sweep {args.study} --results {args.results}` first")

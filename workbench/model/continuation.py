@@ -4,8 +4,9 @@ continuation (Keller; Seydel, *Practical Bifurcation and Stability Analysis*, 3r
 The unknowns are an orbit's reduced coordinates z (:mod:`workbench.model.orbit`: the state
 at phase 0 on its regime's manifold) and the parameter lambda (Hz or N), both on scales
 (the error scales of z, the range of lambda), u = (z / d, lambda / range).  From an orbit u0
-with unit tangent t0 (the null vector of [J - I, dR/dlambda], oriented along the last one,
-the first towards larger lambda), the predictor is u0 + ds t0 and the corrector Newton's
+with unit tangent t0 (the null vector of [J - I, dR/dlambda], oriented along the secant
+from the orbit before, in the full state, so that a change of reduced coordinates does not
+turn it round; the first towards the range's end), the predictor is u0 + ds t0 and the corrector Newton's
 method on
 
     R(z, lambda) = Phi(x(z), lambda) - x(z) = 0,    t0 . (u - u0) - ds = 0,
@@ -28,6 +29,14 @@ stability is undetermined are skipped) a change in the number of multipliers out
 unit circle is a bifurcation, named by the multiplier that crossed: through +1 a fold (a
 saddle-node), through -1 a period doubling, as a complex pair a Neimark-Sacker; an open gap
 whose minimum starts or stops touching zero, a grazing.
+
+**Branch switching at a period doubling** (Seydel §7.4; Kuznetsov, *Elements of Applied
+Bifurcation Theory*, 3rd ed., §4.5): where a multiplier crosses -1, the orbits of twice the
+period branch off.  :func:`doubled_start` seeks one by shooting the 2K-period map from the
+orbit on either side of the crossing, moved along the eigenvector of its multiplier nearest
+-1 by SWITCH_OFFSETS of its error scales, and takes an orbit only if its K-period map does
+not return it (farther than SAME_ORBIT on the scales: not the K-period orbit again);
+:func:`continue_doubled` traces that branch onwards, away from the crossing.
 """
 from __future__ import annotations
 
@@ -53,12 +62,18 @@ JUMP = 3.0
 #: A corrector converges at this scaled residual (as a single orbit's).
 CORRECTOR_TOL = 1e-7
 #: The branch ends after this many orbits at most.
-MAX_ORBITS = 200
+MAX_ORBITS = 600
 #: A variational monodromy whose multipliers' error estimate exceeds this (an event met
 #: nearly tangentially: at 15.05 Hz, 200 N, 0.19) gives the tangent no direction: the
 #: tangent is then taken from finite differences of the map, and a corrector that fails with
 #: the variational Jacobian is tried again with theirs.
 POOR = 1e-2
+#: Branch switching: the offsets along the critical Floquet vector (its largest component
+#: on the error scales) from which the doubled orbit is sought, smallest first.
+SWITCH_OFFSETS = (0.01, 0.03, 0.1, 0.3)
+#: A 2K-period orbit whose K-period map moves it less than this (largest component on the
+#: error scales) is the K-period orbit.
+SAME_ORBIT = 1e-4
 
 
 @dataclass
@@ -111,7 +126,6 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
     value, orbit = lo, start
     determined = start               # the last orbit whose stability the multipliers decide
     branch.orbits.append((value, orbit))
-    tangent = None
     while len(branch.orbits) < MAX_ORBITS:
         if on_orbit:
             on_orbit(branch)
@@ -126,7 +140,12 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
             J = shooter.fd_monodromy(manifold, orbit.state, orbit.regime, ex, scale)
         dR = shooter.d_parameter(manifold, orbit.state, orbit.regime, value)
         pin = _pin(orbit, manifold, d)
-        tangent = _tangent(J, dR, d, manifold, tangent, pin, direction)
+        secant = None
+        if len(branch.orbits) > 1:
+            last_value, last = branch.orbits[-2]
+            secant = np.concatenate([(orbit.state - last.state) / scale,
+                                     [(value - last_value) / span]])
+        tangent = _tangent(J, dR, d, manifold, orbit.state, scale, secant, pin, direction)
         accepted = None
         while accepted is None:
             if ds < DS_MIN:
@@ -180,10 +199,13 @@ def _pin(orbit, manifold, d) -> np.ndarray | None:
     return row / np.linalg.norm(row)
 
 
-def _tangent(J, dR, d, manifold, previous, pin=None, direction: float = 1.0) -> np.ndarray:
+def _tangent(J, dR, d, manifold, x, scale, secant=None, pin=None,
+             direction: float = 1.0) -> np.ndarray:
     """The unit tangent (scaled) of the branch: the null vector of [J - I, dR] on the scales
-    (and of the pin, :func:`_pin`), oriented along ``previous`` (else towards lambda's
-    ``direction``)."""
+    (and of the pin, :func:`_pin`), oriented along ``secant`` (the step from the orbit before
+    to this one: full state on the error scales ``scale``, and the scaled parameter), which
+    holds where the regime at phase 0, and with it the reduced coordinates, changes; else
+    towards lambda's ``direction``."""
     n = manifold.dim
     A = np.hstack([(J - np.eye(n)) * d[:n][None, :], (dR * d[n])[:, None]]) / d[:n][:, None]
     if pin is not None:
@@ -191,8 +213,9 @@ def _tangent(J, dR, d, manifold, previous, pin=None, direction: float = 1.0) -> 
     _, _, vt = np.linalg.svd(A)
     t = vt[-1]
     t /= np.linalg.norm(t)
-    if previous is not None and len(previous) == len(t):
-        return t if t @ previous >= 0 else -t
+    if secant is not None:
+        full = np.concatenate([(manifold.move(x, t[:n] * d[:n]) - x) / scale, [t[n]]])
+        return t if full @ secant >= 0 else -t
     return t if t[-1] * direction >= 0 else -t
 
 
@@ -258,6 +281,65 @@ def _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds):
     if np.max(np.abs(found.state - orbit.state) / scale) > JUMP * ds:
         return None
     return lam, found, found.newton_iterations
+
+
+def doubled_start(shooter: Shooter, branch: Branch, index: int):
+    """(value, Orbit of 2K periods, side) born at the period doubling between the branch's
+    orbits ``index - 1`` and ``index`` (module docstring), side +1 where it was found on the
+    far orbit's side, -1 on the near one's; None where no such orbit is found."""
+    from .orbit import periodic_orbit
+    for side, (value, orbit) in ((1, branch.orbits[index]), (-1, branch.orbits[index - 1])):
+        if orbit.monodromy is None or not len(orbit.multipliers):
+            continue
+        mu, vectors = np.linalg.eig(orbit.monodromy)
+        k = int(np.argmin(np.abs(mu + 1.0)))
+        ex = shooter.drive_at(value)
+        manifold = shooter.manifold(orbit.state, orbit.regime)
+        try:
+            scale = error_scales(shooter.P, shooter.run(orbit.state, orbit.regime, ex).states)
+        except ParameterError:
+            continue
+        d = reduced_scales(manifold, scale)
+        v = np.real(vectors[:, k])
+        v = v / np.max(np.abs(v) / d)
+        for offset in SWITCH_OFFSETS:
+            guess = manifold.project(manifold.move(orbit.state, offset * v))
+            found = periodic_orbit(shooter.params, ex, 2 * shooter.periods,
+                                   guess=(guess, orbit.regime), fixed=shooter.fixed,
+                                   phases=(shooter.phase,), monodromy=shooter.method)
+            if found.status in ("ok", "grazing") and _moved_by_period(shooter, found, ex) \
+                    > SAME_ORBIT:
+                return value, found, side
+    return None
+
+
+def _moved_by_period(shooter: Shooter, orbit: Orbit, ex) -> float:
+    """How far the K-period map moves a 2K-period orbit's state (largest component on its
+    error scales): zero for a K-period orbit."""
+    record = shooter.run(orbit.state, orbit.regime, ex)
+    if not record.ok:
+        return 0.0
+    scale = error_scales(shooter.P, record.states)
+    return float(np.max(np.abs(record.states[-1, :len(orbit.state)] - orbit.state) / scale))
+
+
+def continue_doubled(shooter: Shooter, branch: Branch, index: int, lo: float, hi: float,
+                     on_orbit: Callable | None = None) -> Branch:
+    """The branch of twice the period born at the period doubling before the branch's orbit
+    ``index``, traced from the orbit :func:`doubled_start` finds away from the crossing:
+    towards ``hi`` (the parent's end) where it was found beyond the crossing, else back
+    towards ``lo``.  Status "no start" where none is found."""
+    t0 = time.perf_counter()
+    start = doubled_start(shooter, branch, index)
+    if start is None:
+        out = Branch(shooter.parameter, status="no start", message=(
+            f"no orbit of {2 * shooter.periods} periods found beside the period doubling at "
+            f"{branch.orbits[index][0]:.6g}"))
+        return _done(out, t0, on_orbit)
+    value, orbit, side = start
+    doubled = Shooter(shooter.params, shooter.drive_at(value), 2 * shooter.periods,
+                      shooter.fixed, shooter.parameter, shooter.method)
+    return continue_branch(doubled, value, hi if side > 0 else lo, on_orbit, start=orbit)
 
 
 def branch_rows(branch: Branch) -> list[dict]:

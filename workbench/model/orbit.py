@@ -125,7 +125,8 @@ class Orbit:
     neutral: complex | None = None    # the stuck position's multiplier (module docstring)
     monodromy: np.ndarray | None = None   # the K-period map's Jacobian, reduced coordinates
     responses: dict = field(default_factory=dict)   # amplitude and RMS of accel1-3 (cm/s²) and
-                                                    # strain1-2 over the orbit
+                                                    # strain1-2 over the orbit; tip_h1_cm, the
+                                                    # tip's line at the drive frequency (cm)
     tip_rms_cm: float = float("nan")
     multiplier_error: float = float("nan")   # the multipliers' error estimate (module docstring)
     phase: float = 0.0                # the section's drive phase (fraction of a period)
@@ -606,6 +607,11 @@ def _orbit_facts(record, P, periods, T) -> dict:
         x = record.signal(name)
         responses[f"{name}_amplitude"] = float((x.max() - x.min()) / 2.0)
         responses[f"{name}_rms"] = float(np.std(x))
+    # the tip's line at the drive frequency: the K-th harmonic of the orbit's period, by the
+    # discrete Fourier sum over its samples (the last, the first's repeat, left out): exact
+    # for a periodic record, no window needed
+    phase = np.exp(-2j * np.pi * periods * (record.t[:-1] - record.t[0]) / T)
+    responses["tip_h1_cm"] = float(2.0 * np.abs(np.mean(tip[:-1] * phase)))
     return {"events_per_period": per, "contact_time_share": record.contact_time_share(),
             "tip_amplitude_cm": float((tip.max() - tip.min()) / 2.0),
             "tip_rms_cm": float(np.std(tip)), "responses": responses,

@@ -2,16 +2,20 @@
 (one row per orbit, :func:`workbench.model.continuation.branch_rows`, rewritten after every
 orbit so that an interrupted continuation keeps every orbit found), the frequency- (or
 force-) response curve with stable orbits solid and unstable dashed and the bifurcations
-marked, and ``report.md``."""
+marked, and ``report.md``; and a continuation study's report (:mod:`workbench.study.branches`:
+its branches, and a stepped study set beside them)."""
 from __future__ import annotations
 
 from pathlib import Path
+
+import json
 
 import numpy as np
 import pandas as pd
 
 from ..model.continuation import Branch, branch_rows
-from ..study.store import write_atomic
+from ..study import branches as B
+from ..study.store import write_atomic, write_text_atomic
 from . import figures as F
 from . import units
 
@@ -21,33 +25,50 @@ PARAMETER_LABELS = {"freq_hz": "drive frequency (Hz)", "force_n": "drive force (
 MARKERS = {"fold": "s", "period doubling": "D", "neimark-sacker": "^", "grazing": "x"}
 
 
-def branch_figure(table: pd.DataFrame, parameter: str, title: str):
-    """The tip's amplitude (mm) along the branch: stable orbits solid, unstable (or of
-    undetermined stability) dashed, each bifurcation marked at the orbit after it."""
+def branch_figure(table: pd.DataFrame, parameter: str, title: str,
+                  column: str = "tip_amplitude_cm", overlay: pd.DataFrame | None = None):
+    """The tip's amplitude (mm; ``column``: half its range, or ``tip_h1_cm``, its line at the
+    drive frequency) along each branch of ``table`` (one, or several told apart by a
+    ``branch`` column): stable orbits solid, unstable (or of undetermined stability) dashed,
+    each bifurcation marked at the orbit after it; ``overlay``: a stepped sweep's points
+    (:func:`workbench.study.branches.stepped_beside`), up and down apart."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7.0, 4.2), layout="constrained")
     unit, factor = units.channel("tip")
-    x, y = table[parameter].to_numpy(), table.tip_amplitude_cm.to_numpy() * factor
-    stable = table.stable.to_numpy(bool)
-    for i in range(len(x) - 1):
-        both = stable[i] and stable[i + 1]
-        ax.plot(x[i:i + 2], y[i:i + 2], "-" if both else "--", color="C0" if both else "C3",
-                lw=1.4)
-    ax.plot(x[stable], y[stable], "o", color="C0", ms=3, label="stable")
-    word = table.stability.to_numpy()
-    ax.plot(x[word == "unstable"], y[word == "unstable"], "o", mfc="none", color="C3", ms=4,
-            label="unstable")
-    if (word == "undetermined").any():
-        ax.plot(x[word == "undetermined"], y[word == "undetermined"], "o", mfc="none",
-                color="0.5", ms=4, label="undetermined (|μ| within its error of 1)")
-    for kind, marker in MARKERS.items():
-        at = table.bifurcation == kind
-        if at.any():
-            ax.plot(x[at], y[at], marker, color="k", ms=7, mfc="none", label=kind)
+    groups = table.groupby("branch", sort=False) if "branch" in table else [("", table)]
+    first = True
+    for _, part in groups:
+        x, y = part[parameter].to_numpy(), part[column].to_numpy() * factor
+        stable = part.stable.to_numpy(bool)
+        for i in range(len(x) - 1):
+            both = stable[i] and stable[i + 1]
+            ax.plot(x[i:i + 2], y[i:i + 2], "-" if both else "--",
+                    color="C0" if both else "C3", lw=1.4)
+        word = part.stability.to_numpy()
+        ax.plot(x[stable], y[stable], "o", color="C0", ms=3, label="stable" if first else None)
+        ax.plot(x[word == "unstable"], y[word == "unstable"], "o", mfc="none", color="C3",
+                ms=4, label="unstable" if first else None)
+        if (word == "undetermined").any():
+            ax.plot(x[word == "undetermined"], y[word == "undetermined"], "o", mfc="none",
+                    color="0.5", ms=4, label="undetermined (|μ| within its error of 1)")
+        for kind, marker in MARKERS.items():
+            at = (part.bifurcation == kind).to_numpy()
+            if at.any():
+                ax.plot(x[at], y[at], marker, color="k", ms=7, mfc="none", label=kind)
+        first = False
+    if overlay is not None and len(overlay):
+        for direction, marker in (("up", "^"), ("down", "v")):
+            at = overlay.direction == direction
+            if at.any():
+                ax.plot(overlay[parameter][at], overlay.stepped_tip_h1_cm[at] * factor, marker,
+                        color="C2", ms=7, mfc="none", label=f"stepped sweep, {direction}")
+    handles, labels = ax.get_legend_handles_labels()
+    keep = dict(zip(labels, handles))
+    ax.legend(keep.values(), keep.keys(), fontsize=8)
     ax.set_xlabel(PARAMETER_LABELS[parameter])
-    ax.set_ylabel(f"tip amplitude ({unit})")
+    ax.set_ylabel(f"tip {'line at the drive frequency' if column == 'tip_h1_cm' else 'amplitude'}"
+                  f" ({unit})")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
     ax.set_title(title, fontsize=9)
     return fig
 
@@ -70,7 +91,7 @@ def write_branch(branch: Branch, out: Path, params) -> None:
     if len(table):
         F.save(branch_figure(table, branch.parameter, title), out / "branch")
     stable = table.stable.to_numpy(bool) if len(table) else np.zeros(0, bool)
-    lines = [f"# A branch of periodic orbits", "", title + ".", "",
+    lines = ["# A branch of periodic orbits", "", title + ".", "",
              f"Status: {branch.status} ({branch.message}); {len(table)} orbits, "
              f"{int(stable.sum())} stable, "
              f"{int((table.stability == 'undetermined').sum()) if len(table) else 0} of "
@@ -88,3 +109,135 @@ def write_branch(branch: Branch, out: Path, params) -> None:
     lines += ["![branch](branch.png) ([PDF](branch.pdf)); every orbit: "
               "[branch.parquet](branch.parquet) (CGS, as the points table).", ""]
     (out / "report.md").write_text("\n".join(lines) + "\n")
+
+
+def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> Path:
+    """``report.md``: each branch's end, orbits and bifurcations, the doubled branches, and
+    the stepped study beside the branches with its cost (module docstring)."""
+    c = study.continuation
+    unit = B.PARAMETERS[c.parameter]
+    lines = [f"# {study.name}: branches of periodic orbits", "", study.description, "",
+             f"Continued in {PARAMETER_LABELS[c.parameter]} from {c.start:g} to {c.end:g} "
+             f"{unit}, orbits of {c.periods} drive period(s); drive {study.excitation}; fixed "
+             f"{study.fixed or 'none'}; one branch per {list(study.axes) or 'study'} "
+             "(`workbench/model/continuation.py`; every orbit: [branches.parquet]"
+             "(branches.parquet)).  An orbit is found when its residual is at most 1e-7 of "
+             "the error scales (the map integrated at tolerance 1e-9).", "",
+             "| branch | status | orbits | stable | bifurcations | wall (s) |",
+             "|---|---|---|---|---|---|"]
+    summaries = []
+    for p in study.points:
+        f = out / B.label(p) / "summary.json"
+        if not f.is_file():
+            lines.append(f"| {B.label(p)} | not finished | | | | |")
+            continue
+        s = json.loads(f.read_text())
+        summaries.append((p, s))
+        parts = [(B.label(p), s)] + ([(f"{B.label(p)}/from-end", s["from_end"])]
+                                   if s["from_end"] else [])
+        for name, part in parts:
+            rows = table[table.branch == name] if len(table) else table
+            bif = "; ".join(f"{b['kind']} at {b['at']:.5g}" for b in part["bifurcations"])
+            wall = part["wall_s"] if name != B.label(p) else s["wall_s"] - sum(
+                d["wall_s"] for d in [s["from_end"] or {"wall_s": 0.0}, *s["doubled"]])
+            lines.append(f"| [{name}]({name}/report.md) | {part['status']}: {part['message']} "
+                         f"| {part['orbits']} | {int(rows.stable.sum()) if len(rows) else 0} | "
+                         f"{bif or 'none'} | {wall:.0f} |")
+    if any(s["from_end"] for _, s in summaries):
+        lines += ["", "A branch that ends before its range's end (a fold back past its start, "
+                  "a step floor) is traced again from the range's other end (`from-end`)."]
+    doubled = [(s["label"], d) for _, s in summaries for d in s["doubled"]]
+    if doubled:
+        lines += ["", "Branches of twice the period, switched to at the period doublings "
+                  "(`continue_doubled`):", "", "| branch | status | orbits |", "|---|---|---|"]
+        lines += [f"| [{lab}/{d['folder']}]({lab}/{d['folder']}/report.md) | {d['status']}: "
+                  f"{d['message']} | {d['orbits']} |" for lab, d in doubled]
+    if c.compare:
+        lines += ["", *_comparison(study, out, table, results, summaries)]
+    text = "\n".join(lines) + "\n"
+    write_text_atomic(text, out / "report.md")
+    return out / "report.md"
+
+
+def _comparison(study, out, table, results, summaries) -> list[str]:
+    """The stepped study beside the branches: a table per branch, its figure, its cost."""
+    c = study.continuation
+    f = results / c.compare / "points.parquet"
+    lines = [f"## The stepped study `{c.compare}` beside the branches", ""]
+    if not f.is_file():
+        return lines + [f"No results at {f}: run its study first "
+                        f"(`workbench sweep studies/{c.compare}.toml`)."]
+    stepped = pd.read_parquet(f)
+    if f"axis_{c.parameter}" not in stepped:
+        return lines + [f"The study `{c.compare}` has no axis {c.parameter}: nothing to set "
+                        "beside the branches."]
+    lines += ["Per stepped point, its tip line at the drive frequency (`tip_h1`, a "
+              "least-squares fit over its window) against the nearest orbit's there (exact "
+              "over the period); `steady` is the stepped run's own indicator (the tip RMS of "
+              "its last two windows within its tolerance), the Poincaré spread the range of "
+              "its tip at the drive's phase 0 over the window (zero on a period-1 orbit).", ""]
+    total_branch, total_stepped = 0.0, 0.0
+    for p, s in summaries:
+        mask = np.ones(len(stepped), bool)
+        for k, v in p.values.items():
+            col = f"axis_{k}"
+            if col in stepped:
+                mask &= np.isclose(stepped[col].to_numpy(float), float(v)) \
+                    if isinstance(v, float) else (stepped[col] == v).to_numpy()
+        points = stepped[mask & (stepped.status == "ok")]
+        branch = table[(table.branch == B.label(p)) | table.branch.str.startswith(B.label(p) + "/")
+                       ] if len(table) else table
+        if not len(points) or not len(branch):
+            continue
+        beside = B.stepped_beside(branch, points, c.parameter)
+        if not len(beside):
+            lines += [f"### {B.label(p)}", "", "No stepped point inside the branch's range.", ""]
+            continue
+        write_atomic(beside, out / B.label(p) / "stepped_beside.parquet")
+        total_branch += s["wall_s"] - sum(d["wall_s"] for d in s["doubled"])   # from-end in
+        ran = points[f"axis_{c.parameter}"].between(branch[c.parameter].min(),
+                                                    branch[c.parameter].max())
+        total_stepped += float(points.wall_s[ran].sum())
+        lines += [f"### {B.label(p)}", "",
+                  "| value | sweep | stepped tip_h1 (cm) | steady | Poincaré spread (cm) | "
+                  "orbits there (stable) | nearest orbit (cm) | its stability | difference |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        for _, r in beside.iterrows():
+            near = ("| — | — | — |" if not r.orbits_there else
+                    f"| {r.orbit_tip_h1_cm:.4f} | {'stable' if r.orbit_stable else 'unstable'}"
+                    f" | {100 * r.difference_rel:.2f} % |")
+            lines.append(f"| {r[c.parameter]:g} | {r.direction} | {r.stepped_tip_h1_cm:.4f} | "
+                         f"{'yes' if r.stepped_steady else 'no'} | "
+                         f"{r.stepped_poincare_spread_cm:.3f} | {r.orbits_there} "
+                         f"({r.stable_orbits_there}) {near}")
+        jumps = B.jumps_and_folds(beside, branch, c.parameter)
+        lines.append("")
+        if jumps:
+            lines += [f"Where the sweeps up and down differ (by more than {100 * B.HYSTERESIS:g} % "
+                      "of the larger: a jump between there and a neighbouring step), the "
+                      "branch's nearest folds on either side and its stable orbits there:", "",
+                      "| value | up (cm) | down (cm) | fold below | fold above | stable orbits "
+                      "there | bracketed |", "|---|---|---|---|---|---|---|"]
+            fmt = lambda v: "none" if v is None else f"{v:.4g}"          # noqa: E731
+            lines += [f"| {j[c.parameter]:g} | {j['up']:.4f} | {j['down']:.4f} | "
+                      f"{fmt(j['fold_below'])} | {fmt(j['fold_above'])} | {j['stable_orbits']} "
+                      f"| {'yes' if j['fold_below'] is not None and j['fold_above'] is not None else 'no'} |"
+                      for j in jumps]
+        else:
+            lines.append(f"The sweeps up and down agree (within {100 * B.HYSTERESIS:g} %) at every "
+                         "value: no jump to bracket.")
+        fig = branch_figure(branch, c.parameter, f"{B.label(p)}: the branch (tip line at the "
+                            "drive frequency) and the stepped sweep's points",
+                            column="tip_h1_cm", overlay=beside)
+        F.save(fig, out / B.label(p) / "stepped_beside")
+        lines += ["", f"![{B.label(p)}]({B.label(p)}/stepped_beside.png)", ""]
+    if total_stepped:
+        lines += ["### Cost", "",
+                  f"The branches (the doubled ones aside) took {total_branch:.0f} s of worker "
+                  f"time; the stepped study's points at the same axis values "
+                  f"{total_stepped:.0f} s (the sum of their runs' wall times in "
+                  f"`{c.compare}/points.parquet`; its tolerance "
+                  f"{stepped.tol.iloc[0]:.0e}, {stepped.simulated_s.iloc[0]:g} s a step, "
+                  "steady states only where the transient has died).  Both measured on this "
+                  "machine, not side by side.", ""]
+    return lines

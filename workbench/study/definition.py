@@ -52,6 +52,9 @@ frequencies (all other axes equal) in order, each point's search starting
 from the force its lower neighbour used; only the force carries over, not
 the state.
 
+A ``continuation`` table in ``[study]`` traces branches of periodic orbits instead, one per
+combination of ``[axes]`` (:mod:`workbench.study.branches` describes it).
+
 A ``[sample]`` table with ``[ranges]`` instead of ``[axes]`` draws the points
 from a Saltelli design for a global sensitivity study
 (:mod:`workbench.study.sensitivity` describes both tables).
@@ -72,15 +75,18 @@ from typing import Any
 import numpy as np
 
 from ..model import drives
-from . import sensitivity
+from . import branches, sensitivity
 from .leveling import Limits
 from .wear import WearConstants, wear_constants
 from ..model.limits import MAX_NAME_CHARS
 from ..model.params import ParameterError, Parameters, check_positive, read_toml, resolve_name
 
 SWEEP_MODES = ("independent", "up", "down", "up-down")
+#: A continuation study's points are checked (the step against the drive) as runs of this
+#: length (s); it runs no grid (:mod:`workbench.study.branches`).
+CONTINUATION_CHECK_S = 1.0
 STUDY_KEYS = {"name", "description", "duration_s", "window_s", "sweep", "dt", "output_hz", "tol",
-              "method", "save_series", "initial", "check_accuracy"}
+              "method", "save_series", "initial", "check_accuracy", "continuation"}
 LIMIT_KEYS = {"accel_g": "g", "force_transducer_n": "N", "tip_cm": "cm"}
 
 
@@ -137,6 +143,7 @@ class Study:
     wear: WearConstants = WearConstants()
     check_accuracy: bool = False
     sample: sensitivity.Sample | None = None
+    continuation: branches.Continuation | None = None
     points: tuple = field(default=(), repr=False)
 
     @property
@@ -192,6 +199,10 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         if table in data and not isinstance(data[table], dict):
             raise StudyError(f"[{table}] must be a table of keys, got {_short(data[table])}")
     head = dict(data.get("study", {}))
+    continuation = None
+    if "continuation" in head:
+        continuation = branches.parse(head.pop("continuation"), head, StudyError)
+        head["duration_s"] = CONTINUATION_CHECK_S
     run = _run_settings(head)
     exc = dict(data.get("excitation", {"drive": "none"}))
     drive = exc.pop("drive", None)
@@ -199,6 +210,16 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
         raise StudyError(f"[excitation] drive = {drive!r}; allowed: {sorted(drives.DRIVES)}")
     fixed = dict(data.get("fixed", {}))
     axes = dict(data.get("axes", {}))
+    if continuation is not None:
+        name = continuation.parameter
+        if drive != "sine" or "sample" in data:
+            raise StudyError("[study] continuation traces orbits of a sine drive over [axes]: "
+                             f"got drive {drive!r}" + (" with [sample]" if "sample" in data
+                                                       else ""))
+        if name in axes or name in exc:
+            raise StudyError(f"[{'axes' if name in axes else 'excitation'}] {name}: the "
+                             "continued parameter's range is the continuation's from and to")
+        exc[name] = continuation.start
     sample = None
     if "sample" in data or "ranges" in data:
         if axes:
@@ -236,7 +257,7 @@ def from_dict(data: dict[str, Any], source: str = "") -> Study:
     series = _save_series(head.get("save_series", []), set(axes) | set(drives.DRIVES[drive].keys))
     return Study(**run, excitation={"drive": drive, **exc}, fixed=fixed, axes=axes,
                  save_series=series, source=source, points=tuple(points), limits=limits,
-                 wear=wear, sample=sample)
+                 wear=wear, sample=sample, continuation=continuation)
 
 
 def _run_settings(head: dict) -> dict:

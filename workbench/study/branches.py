@@ -1,0 +1,336 @@
+"""A study of branches of periodic orbits instead of a grid of runs.
+
+    [study]
+    name = "branches"
+    continuation = {parameter = "freq_hz", from = 10.0, to = 55.0}
+    # optional keys of the table: periods = 1 (K, drive periods an orbit spans),
+    # period_doubling = true (at each period doubling also trace the doubled branch),
+    # compare = "stepped" (a stepped study whose steady states are set over the branches),
+    # monodromy = "variational" (or "finite-difference")
+
+    [excitation]
+    drive = "sine"
+    force_n = 200.0                  # the drive's other setting
+
+    [fixed]
+    tip_mass = true
+
+    [axes]                           # one branch per combination (not the continued parameter)
+    gap_mm = [0.508, 1.016]
+
+Each branch (:func:`workbench.model.continuation.continue_branch`) is written to
+``results/<name>/<label>/`` as ``workbench continue`` writes it
+(:mod:`workbench.present.branch`, which also writes the study's report) (``branch.parquet`` after
+every orbit, the figure and ``report.md`` at its end; ``summary.json`` marks it finished, so
+that a study run again resumes with the branches not yet finished, each from its start).
+A branch that ends before the range's end is traced again from that end
+(``<label>/from-end/``), and a doubled branch goes to ``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
+holds every orbit of every branch, ``report.md`` the study's account.
+
+With ``compare``, each stepped point of that study (``results/<compare>/points.parquet``)
+whose other axes match a branch's is set beside the branch at its frequency: the tip's line
+at the drive frequency (``tip_h1``, which the first mode's slow ringing does not reach) of
+the stepped run against that of the nearest orbit there (linear between the two orbits that
+bracket the frequency on each of the branches' segments), and each value where the sweeps up
+and down differ (HYSTERESIS: a jump) against the branch's nearest folds on either side.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..model.limits import MONODROMY_METHODS
+from ..model.params import ParameterError
+from .store import StudyLock, log_run, update_run, write_atomic, write_text_atomic
+
+#: The table's keys.
+KEYS = {"parameter", "from", "to", "periods", "period_doubling", "compare", "monodromy"}
+#: The continued parameters and their units.
+PARAMETERS = {"freq_hz": "Hz", "force_n": "N"}
+#: Up and down sweeps whose tip lines at one value differ by more than this fraction of the
+#: larger found different responses there (hysteresis: a jump between there and a neighbour).
+HYSTERESIS = 0.1
+#: [study] keys of a grid's runs, which a continuation study does not take.
+GRID_ONLY = ("duration_s", "window_s", "sweep", "save_series", "check_accuracy", "dt",
+             "output_hz", "tol", "method", "initial")
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """The ``[study] continuation`` table: what is continued, over what, and how."""
+
+    parameter: str
+    start: float
+    end: float
+    periods: int = 1
+    period_doubling: bool = False
+    compare: str | None = None
+    monodromy: str = "variational"
+
+
+def parse(raw, head: dict, error=ParameterError) -> Continuation:
+    """The table, checked (one-line errors naming the key, the value and what is allowed)."""
+    if not isinstance(raw, dict):
+        raise error("[study] continuation must be a table such as {parameter = \"freq_hz\", "
+                    f"from = 10.0, to = 55.0}}, got {raw!r}")
+    bad = sorted(set(raw) - KEYS)
+    if bad:
+        raise error(f"unknown key(s) {bad} in [study] continuation; allowed: {sorted(KEYS)}")
+    grid = sorted(k for k in GRID_ONLY if k in head)
+    if grid:
+        raise error(f"[study] {grid[0]} sets a grid's runs; a study with continuation traces "
+                    "branches of periodic orbits (no duration, window or sweep)")
+    parameter = raw.get("parameter")
+    if parameter not in PARAMETERS:
+        raise error(f"[study] continuation parameter = {parameter!r}; allowed: "
+                    f"{sorted(PARAMETERS)}")
+    ends = []
+    for key in ("from", "to"):
+        v = raw.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0:
+            raise error(f"[study] continuation {key} = {v!r} must be a positive number "
+                        f"({PARAMETERS[parameter]})")
+        ends.append(float(v))
+    if ends[0] == ends[1]:
+        raise error(f"[study] continuation from = to = {ends[0]:g}: the range is empty")
+    if parameter == "force_n":
+        from ..model.limits import MAX_FORCE_N
+        if max(ends) > MAX_FORCE_N:
+            raise error(f"[study] continuation {'from' if ends[0] > MAX_FORCE_N else 'to'} = "
+                        f"{max(ends):g} N; allowed (0, {MAX_FORCE_N:g}] N")
+    periods = raw.get("periods", 1)
+    if isinstance(periods, bool) or not isinstance(periods, int) or not 1 <= periods <= 8:
+        raise error(f"[study] continuation periods = {periods!r} must be a whole number in "
+                    "[1, 8] (drive periods an orbit spans)")
+    doubling = raw.get("period_doubling", False)
+    if not isinstance(doubling, bool):
+        raise error(f"[study] continuation period_doubling = {doubling!r} must be true or false")
+    compare = raw.get("compare")
+    if compare is not None and (not isinstance(compare, str) or not compare):
+        raise error(f"[study] continuation compare = {compare!r} must name a study "
+                    "(results/<compare>/points.parquet)")
+    monodromy = raw.get("monodromy", "variational")
+    if monodromy not in MONODROMY_METHODS:
+        raise error(f"[study] continuation monodromy = {monodromy!r}; allowed: "
+                    f"{', '.join(MONODROMY_METHODS)}")
+    return Continuation(parameter, ends[0], ends[1], periods, doubling, compare, monodromy)
+
+
+def label(point) -> str:
+    """A branch's folder name: its axis values (``gap_mm-0.508``), or ``branch``."""
+    if not point.values:
+        return "branch"
+    return "_".join(f"{k}-{v:g}" if isinstance(v, float) else f"{k}-{v}"
+                    for k, v in point.values.items())
+
+
+def run_branches(study, write, results: str | Path = "results", jobs: int = 2,
+                 fresh: bool = False, progress: bool = True) -> pd.DataFrame:
+    """Trace every unfinished branch of a continuation study (``jobs`` processes), each
+    written by ``write(branch, folder, params)`` after every orbit
+    (:func:`workbench.present.branch.write_branch`); write and return ``branches.parquet``
+    (every orbit, with its branch's axis values and label)."""
+    from joblib import Parallel, delayed
+    out = Path(results).resolve() / study.name
+    out.mkdir(parents=True, exist_ok=True)
+    with StudyLock(out):
+        todo = [p for p in study.points if fresh or not finished(study, p, out)]
+        if todo:
+            if progress:
+                print(f"workbench: {study.name}: {len(todo)} of {study.n_points} branches to "
+                      f"trace on {min(jobs, len(todo))} worker(s)", file=sys.stderr)
+            t0 = time.perf_counter()
+            index = log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                                  "branches_run": len(todo), "jobs": jobs, "pid": os.getpid(),
+                                  "state": "running"})
+            state = "failed"
+            try:
+                Parallel(n_jobs=min(jobs, len(todo)))(
+                    delayed(trace)(study, p, out / label(p), write) for p in todo)
+                state = "done"
+            except KeyboardInterrupt:
+                state = "interrupted"
+                raise
+            finally:
+                update_run(out, index, {"state": state, "wall_s": time.perf_counter() - t0})
+        table = collect(study, out)
+        write_atomic(table, out / "branches.parquet")
+    return table
+
+
+def definition(study, point) -> dict:
+    """What a branch is traced from: a finished branch whose summary holds another is traced
+    again."""
+    from dataclasses import asdict
+    return json.loads(json.dumps({"continuation": asdict(study.continuation),
+                                  "values": point.values, "excitation": point.excitation,
+                                  "fixed": study.fixed}, default=str))
+
+
+def finished(study, point, out: Path) -> bool:
+    """Whether the branch's folder holds a finished branch of this definition."""
+    f = out / label(point) / "summary.json"
+    try:
+        return json.loads(f.read_text()).get("definition") == definition(study, point)
+    except (OSError, ValueError):
+        return False
+
+
+def trace(study, point, folder: Path, write) -> dict:
+    """One branch (and its doubled branches): written to ``folder``; its summary (status
+    "failed" with the error where tracing raised: the other branches go on)."""
+    try:
+        return _trace(study, point, folder, write)
+    except Exception as exc:                           # noqa: BLE001 - kept in the summary
+        summary = {"label": folder.name, "definition": definition(study, point),
+                   "status": "failed",
+                   "message": f"{type(exc).__name__}: {exc}", "orbits": 0, "wall_s": 0.0,
+                   "bifurcations": [], "from_end": None, "doubled": []}
+        write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
+        return summary
+
+
+def _trace(study, point, folder: Path, write) -> dict:
+    from ..model.continuation import continue_branch, continue_doubled
+    from ..model.orbit import Shooter
+    c = study.continuation
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "summary.json").unlink(missing_ok=True)
+    for old in folder.glob("**/branch.parquet"):         # an earlier definition's, or cut short
+        old.unlink()
+    shooter = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
+                      c.monodromy)
+    branch = continue_branch(shooter, c.start, c.end,
+                             on_orbit=lambda b: write(b, folder, point.params))
+    summary = {"label": folder.name, "definition": definition(study, point),
+               "status": branch.status, "message": branch.message,
+               "orbits": len(branch.orbits), "wall_s": branch.wall_s,
+               "bifurcations": [{"at": branch.orbits[i][0], "kind": k}
+                                for i, k in branch.bifurcations],
+               "from_end": None, "doubled": []}
+    traced = [(branch, shooter)]
+    if branch.status != "done":
+        back = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
+                       c.monodromy)
+        sub = folder / "from-end"
+        other = continue_branch(back, c.end, c.start,
+                                on_orbit=lambda b: write(b, sub, point.params))
+        summary["from_end"] = {"folder": sub.name, "status": other.status,
+                               "message": other.message, "orbits": len(other.orbits),
+                               "wall_s": other.wall_s,
+                               "bifurcations": [{"at": other.orbits[i][0], "kind": k}
+                                                for i, k in other.bifurcations]}
+        summary["wall_s"] += other.wall_s
+        traced.append((other, back))
+    if c.period_doubling:
+        for parent, parent_shooter in traced:
+            for i, kind in parent.bifurcations:
+                if kind != "period doubling":
+                    continue
+                sub = folder / f"doubled-{parent.orbits[i][0]:.4g}"
+                doubled = continue_doubled(parent_shooter, parent, i, c.start, c.end,
+                                           on_orbit=lambda b, sub=sub: write(
+                                               b, sub, point.params))
+                summary["doubled"].append({"folder": sub.name, "status": doubled.status,
+                                           "message": doubled.message,
+                                           "orbits": len(doubled.orbits),
+                                           "wall_s": doubled.wall_s,
+                                           "bifurcations": [
+                                               {"at": doubled.orbits[i][0], "kind": k}
+                                               for i, k in doubled.bifurcations]})
+                summary["wall_s"] += doubled.wall_s
+    write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
+    return summary
+
+
+def collect(study, out: Path) -> pd.DataFrame:
+    """Every orbit of every branch on disk, with the branch's axis values, ``branch`` (its
+    folder) and ``periods``."""
+    tables = []
+    for p in study.points:
+        for f in sorted((out / label(p)).glob("**/branch.parquet")):
+            t = pd.read_parquet(f)
+            if not len(t):
+                continue
+            for k, v in p.values.items():
+                t.insert(0, f"axis_{k}", v)
+            t.insert(0, "branch", str(f.parent.relative_to(out)))
+            tables.append(t)
+    return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+
+
+def orbits_at(table: pd.DataFrame, parameter: str, value: float,
+              column: str = "tip_h1_cm") -> list[tuple[float, bool]]:
+    """The orbits at ``value`` of the parameter on every branch of ``table`` (told apart by
+    its ``branch`` column, if any): (``column``, stable) on each segment between two orbits
+    that bracket it, linear between them (stable where both are)."""
+    groups = table.groupby("branch", sort=False) if "branch" in table else [("", table)]
+    found = []
+    for _, part in groups:
+        x = part[parameter].to_numpy(float)
+        y = part[column].to_numpy(float)
+        stable = part.stable.to_numpy(bool)
+        for i in range(len(x) - 1):
+            lo, hi = sorted((x[i], x[i + 1]))
+            if lo < value <= hi or (lo == value and i == 0):
+                w = (value - x[i]) / (x[i + 1] - x[i])
+                found.append((float(y[i] + w * (y[i + 1] - y[i])),
+                              bool(stable[i] and stable[i + 1])))
+        if len(x) == 1 and x[0] == value:
+            found.append((float(y[0]), bool(stable[0])))
+    return found
+
+
+def stepped_beside(branch: pd.DataFrame, stepped: pd.DataFrame, parameter: str
+                   ) -> pd.DataFrame:
+    """Each stepped point beside the branch (module docstring): its tip line, the nearest
+    orbit's there and whether that orbit is stable, their difference relative to the
+    stepped one, and the stepped run's own steadiness."""
+    rows = []
+    lo, hi = branch[parameter].min(), branch[parameter].max()
+    for _, s in stepped.iterrows():
+        value = float(s[f"axis_{parameter}"])
+        if not lo <= value <= hi:
+            continue
+        there = orbits_at(branch, parameter, value)
+        row = {parameter: value, "direction": s.direction, "stepped_tip_h1_cm": s.tip_h1,
+               "stepped_steady": bool(s.steady), "stepped_steady_change": s.steady_change,
+               "stepped_poincare_spread_cm": float(np.ptp(s.tip_poincare))
+               if len(s.tip_poincare) else np.nan,
+               "orbits_there": len(there), "stable_orbits_there": sum(st for _, st in there)}
+        if there:
+            y, st = min(there, key=lambda o: abs(o[0] - s.tip_h1))
+            row.update(orbit_tip_h1_cm=y, orbit_stable=st,
+                       difference_rel=abs(y - s.tip_h1) / max(abs(s.tip_h1), 1e-12))
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def jumps_and_folds(beside: pd.DataFrame, branch: pd.DataFrame, parameter: str
+                    ) -> list[dict]:
+    """Each value where the stepped sweep up and the sweep down found different responses
+    (tip lines apart by more than HYSTERESIS of the larger: a jump lies between there and a
+    neighbouring step), with the nearest fold of the branch on either side and the stable
+    orbits the branch has there: the folds bracket the jump when both exist."""
+    folds = np.sort(branch.loc[branch.bifurcation == "fold", parameter].to_numpy(float))
+    up = beside[beside.direction == "up"].set_index(parameter).stepped_tip_h1_cm
+    down = beside[beside.direction == "down"].set_index(parameter).stepped_tip_h1_cm
+    out = []
+    for value in sorted(set(up.index) & set(down.index)):
+        a, b = float(up[value]), float(down[value])
+        if abs(a - b) <= HYSTERESIS * max(abs(a), abs(b)):
+            continue
+        below, above = folds[folds <= value], folds[folds >= value]
+        there = orbits_at(branch, parameter, value)
+        out.append({parameter: value, "up": a, "down": b,
+                    "fold_below": float(below[-1]) if len(below) else None,
+                    "fold_above": float(above[0]) if len(above) else None,
+                    "stable_orbits": int(sum(st for _, st in there))})
+    return out
