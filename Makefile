@@ -8,7 +8,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 RESULTS := results
 
-.PHONY: help setup test bench study shaker-200n stress sensitivity paper-fit clean
+.PHONY: help setup test bench study branches shaker-200n stress sensitivity paper-fit clean
 
 help:  ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-8s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -41,10 +41,10 @@ bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmark
 		--targets README.md
 
 # The studies of `make study` (studies/<name>.toml -> results/<name>/report.md).
-STUDIES := free_decay stepped chirp shaker damage
+STUDIES := free_decay stepped chirp shaker damage period_doubling
 SOURCES := $(shell find workbench -name "*.py" -not -path "*/__pycache__/*")
 
-study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, damage map, modes, identification, estimator)
+study: $(RESULTS)/index.md  ## run every study (shaker grid, chirps, free decays, stepped sweeps, damage map, period doubling at 20 Hz, modes, identification, estimator)
 
 $(RESULTS)/index.md: $(foreach s,$(STUDIES),$(RESULTS)/$(s)/report.md) $(RESULTS)/modes/modes.md \
 		$(RESULTS)/identification/identification.md $(RESULTS)/estimate/estimate.md \
@@ -55,9 +55,16 @@ $(RESULTS)/index.md: $(foreach s,$(STUDIES),$(RESULTS)/$(s)/report.md) $(RESULTS
 $(RESULTS)/%/report.md: studies/%.toml $(SOURCES) $(STAMP)
 	$(PY) -m workbench sweep $< --results $(RESULTS) || [ $$? -eq 3 ]
 
-# The paper's section 6 observations measured in the model, each with a verdict.
-$(RESULTS)/paper/report.md: $(STAMP) studies/paper.py $(SOURCES)
+# The paper's section 6 observations measured in the model, each with a verdict, and where the
+# period-1 orbit at 20 Hz loses stability (the period doubling study).
+$(RESULTS)/paper/report.md: $(STAMP) studies/paper.py $(SOURCES) $(RESULTS)/period_doubling/report.md
 	$(PY) studies/paper.py --out $(RESULTS)/paper
+
+# The branches of periodic orbits over the stepped study's frequencies, beside its points: not
+# part of `make study`.
+branches: $(RESULTS)/branches/report.md  ## periodic orbits over 10-55 Hz at both gaps against the stepped sweeps (about N minutes)
+
+$(RESULTS)/branches/report.md: $(RESULTS)/stepped/report.md
 
 # Which parameter decides each of the paper's observations: not part of `make study`.
 sensitivity: $(RESULTS)/sensitivity/short_runs.md  ## Sobol' indices of the paper's observations (1 664 runs, about an hour)

@@ -32,6 +32,7 @@ from workbench.model.params import Parameters
 from workbench.model.regimes import contact_shares_of
 from workbench.present import figures as F
 from workbench.present import observations as O
+from workbench.present.branch import period_doubling_finding
 from workbench.present.tables import latex_text
 from workbench.study.leveling import Limits, level
 from workbench.model.validity import accel_peak_g, validity
@@ -265,6 +266,8 @@ def main(argv=None) -> None:
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--rebuild", action="store_true",
                         help="write the tables, figures and report from the saved cases, no runs")
+    parser.add_argument("--doubling", type=Path, default=None,
+                        help="results of studies/period_doubling.toml (default: beside --out)")
     args = parser.parse_args(argv)
     start_wall = time.perf_counter()
     if args.rebuild:
@@ -280,13 +283,57 @@ def main(argv=None) -> None:
         gap_cases = [c for c in done if "gap_mm" in c]
         args.out.mkdir(parents=True, exist_ok=True)
         save_cases(cases, args.out, gap_cases)
-    write_report(cases, args.out, time.perf_counter() - start_wall, gap_cases)
+    write_report(cases, args.out, time.perf_counter() - start_wall, gap_cases,
+                 args.doubling or args.out.parent / "period_doubling")
     print(f"wrote {args.out}/report.md")
 
 
+def doubling_lines(folder: Path) -> list[str]:
+    """The 10 Hz line against the period-1 orbit continued in force at 20 Hz (the period
+    doubling study's results in ``folder``), beside the §6 observation."""
+    f = period_doubling_finding(folder)
+    head = ["## The 10 Hz line and the period-1 orbit (§6, Fig. 7-8)", ""]
+    if f is None:
+        return head + [f"The period doubling study has not run (no results in {folder}: "
+                       "`workbench sweep studies/period_doubling.toml`).", ""]
+    unit = f["unit"]
+    lines = head + [
+        f"The periodic response of period 1 (the drive's), continued in force from "
+        f"{f['start']:g} to {f['end']:.4g} {unit} at {O.DRIVE_HZ:g} Hz "
+        "(`studies/period_doubling.toml`, [its report](../period_doubling/report.md); status "
+        f"{f['status']}: {f['message']}; {f['orbits']} orbits).  At {f['start']:g} {unit} it is "
+        f"{f['first_stable']}, its largest multiplier {f['first_multiplier']:.6f} a period"
+        + (f": a disturbance of it decays with a time constant of "
+           f"{f['time_constant_s']:.0f} s, so a {SINE_S:g} s run from rest is not yet on it"
+           if f["time_constant_s"] else "") + "."]
+    d = f["doubling"]
+    if d is None:
+        lines += ["", f"It loses stability by no period doubling between {f['start']:g} and "
+                  f"{f['end']:.4g} {unit}: the model's steady state there has no 10 Hz line.",
+                  ""]
+        return lines
+    lines += ["", f"**It loses stability by a period doubling between "
+              f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** (a multiplier "
+              f"crosses -1: |μ| {d['multiplier']:.3f} at {d['first_unstable']:.4g} {unit}); "
+              f"above {d['last_stable']:.4g} {unit}, the paper's 200 N included, the model's "
+              "steady state has no 10 Hz line."]
+    dd = d["doubled"]
+    if dd and dd.get("orbits"):
+        lines += ["", f"The branch of period 2 born there ({dd['orbits']} orbits over "
+                  f"{dd['range'][0]:.4g}-{dd['range'][1]:.4g} {unit}, {dd['stable']} stable; "
+                  f"{dd['status']}: {dd['message']}) carries the 10 Hz line: strain1's line at "
+                  f"10 Hz up to {dd['strain_half_over_drive']:.3g} of its 20 Hz line (at "
+                  f"{dd['at']:.4g} {unit}), the tip's up to {10 * dd['tip_half_cm']:.3g} mm."]
+    elif dd:
+        lines += ["", f"No orbit of period 2 was found beside it ({dd['status']}: "
+                  f"{dd['message']})."]
+    return lines + [""]
+
+
 def write_report(cases: list[dict], out: Path, wall_s: float,
-                 gap_cases: list[dict] | None = None) -> None:
-    """The observations' tables, the figures, report.md and provenance.json of the cases."""
+                 gap_cases: list[dict] | None = None, doubling: Path | None = None) -> None:
+    """The observations' tables, the figures, report.md and provenance.json of the cases; the
+    period doubling study's finding from its results in ``doubling``."""
     args = argparse.Namespace(out=out)
     (args.out / "figures").mkdir(parents=True, exist_ok=True)
     gap_cases = gap_cases or []
@@ -341,6 +388,7 @@ def write_report(cases: list[dict], out: Path, wall_s: float,
              "## Rules", ""]
     lines += [f"- {name}: {rule}." for name, rule in O.RULES.items()]
     lines += ["", "## Observations and verdicts", "", obs.to_markdown(index=False), ""]
+    lines += doubling_lines(doubling or out.parent / "period_doubling")
     if gap_cases:
         lines += ["## The 14/23 switching and the 10 Hz line at every gap, within the validated range",
                   "",
@@ -352,7 +400,6 @@ def write_report(cases: list[dict], out: Path, wall_s: float,
                   "both with sensors that did not saturate (§5.2).", "",
                   gap_table(gap_cases).to_markdown(index=False), ""]
     lines += [
-              "## Cases", "",
               "## Cases", "",
               "| case | force (N) | runs to level (limit) | accel peak (g) | validated range | "
               "status | global error estimate | error measured against the companion |",

@@ -48,3 +48,38 @@ def test_the_reports_tables_are_rebuilt_from_the_saved_cases(tmp_path, monkeypat
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "observations.csv"), first)
     assert (tmp_path / "report.md").read_text() == report
     assert (tmp_path / "figures" / "switching_sine_static_default_identified.png").is_file()
+
+
+def test_the_period_doubling_finding_is_read_from_the_study_and_set_beside_the_line(tmp_path):
+    """A made-up force branch (200 N down to 80 N at 20 Hz) whose multiplier crosses -1
+    between 90 and 85 N, and its doubled branch: the report states the bracket, the first
+    orbit's time constant and the 10 Hz line the doubled orbits carry; without the study's
+    results it says the study has not run."""
+    import json
+    import math
+    paper = paper_module()
+    assert "has not run" in "\n".join(paper.doubling_lines(tmp_path / "none"))
+    folder = tmp_path / "period_doubling"
+    (folder / "branch").mkdir(parents=True)
+    summary = {"label": "branch", "status": "done", "message": "reached 80",
+               "definition": {"continuation": {"parameter": "force_n"},
+                              "excitation": {"drive": "sine", "freq_hz": 20.0}},
+               "doubled": [{"folder": "doubled-85", "status": "done", "message": "reached 80",
+                            "orbits": 2, "wall_s": 1.0}]}
+    (folder / "branch" / "summary.json").write_text(json.dumps(summary))
+    main = pd.DataFrame({"branch": "branch", "force_n": [200.0, 150.0, 90.0, 85.0, 80.0],
+                         "stability": ["stable"] * 3 + ["unstable"] * 2,
+                         "stable": [True] * 3 + [False] * 2,
+                         "max_multiplier": [0.9995, 0.999, 0.99, 1.2, 1.3],
+                         "bifurcation": ["", "", "", "period doubling", ""],
+                         "strain1_h0.5": 0.0, "strain1_h1": 1e-4, "tip_h0.5_cm": 0.0})
+    doubled = pd.DataFrame({"branch": "branch/doubled-85", "force_n": [85.0, 80.0],
+                            "stability": "stable", "stable": True, "max_multiplier": 0.9,
+                            "bifurcation": "", "strain1_h0.5": [1e-5, 3e-5],
+                            "strain1_h1": 1e-4, "tip_h0.5_cm": [0.01, 0.02]})
+    pd.concat([main, doubled]).to_parquet(folder / "branches.parquet")
+    text = "\n".join(paper.doubling_lines(folder))
+    assert "period doubling between 90 and 85 N" in text and "|μ| 1.200 at 85 N" in text
+    assert f"time constant of {-0.05 / math.log(0.9995):.0f} s" in text
+    assert "2 orbits over 80-85 N, 2 stable" in text and "up to 0.3 of its 20 Hz line" in text
+    assert "the tip's up to 0.2 mm" in text

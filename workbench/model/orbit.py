@@ -129,8 +129,10 @@ class Orbit:
     neutral: complex | None = None    # the stuck position's multiplier (module docstring)
     monodromy: np.ndarray | None = None   # the K-period map's Jacobian, reduced coordinates
     responses: dict = field(default_factory=dict)   # amplitude and RMS of accel1-3 (cm/s²) and
-                                                    # strain1-2 over the orbit; tip_h1_cm, the
-                                                    # tip's line at the drive frequency (cm)
+                                                    # strain1-2 over the orbit; the tip's (cm)
+                                                    # and strain1's lines at the drive frequency
+                                                    # f (tip_h1_cm, strain1_h1) and at f / 2
+                                                    # (tip_h0.5_cm, strain1_h0.5)
     tip_rms_cm: float = float("nan")
     multiplier_error: float = float("nan")   # the multipliers' error estimate (module docstring)
     phase: float = 0.0                # the section's drive phase (fraction of a period)
@@ -637,15 +639,25 @@ def _orbit_facts(record, P, periods, T) -> dict:
         x = record.signal(name)
         responses[f"{name}_amplitude"] = float((x.max() - x.min()) / 2.0)
         responses[f"{name}_rms"] = float(np.std(x))
-    # the tip's line at the drive frequency: the K-th harmonic of the orbit's period, by the
-    # discrete Fourier sum over its samples (the last, the first's repeat, left out): exact
-    # for a periodic record, no window needed
-    phase = np.exp(-2j * np.pi * periods * (record.t[:-1] - record.t[0]) / T)
-    responses["tip_h1_cm"] = float(2.0 * np.abs(np.mean(tip[:-1] * phase)))
+    # the lines at the drive frequency f and at f / 2 (the subharmonic of an orbit of an even
+    # number of periods; zero for one period)
+    for name, x, unit in (("tip", tip, "_cm"), ("strain1", record.signal("strain1"), "")):
+        responses[f"{name}_h1{unit}"] = _line(record.t, x, T, periods)
+        responses[f"{name}_h0.5{unit}"] = _line(record.t, x, T, periods / 2.0)
     return {"events_per_period": per, "contact_time_share": record.contact_time_share(),
             "tip_amplitude_cm": float((tip.max() - tip.min()) / 2.0),
             "tip_rms_cm": float(np.std(tip)), "responses": responses,
             "min_open_gap_cm": smallest, "grazing": bool(smallest < GRAZE_REL * P[ly.P_GAP])}
+
+
+def _line(t, x, T, k) -> float:
+    """The amplitude of x's k-th harmonic over one orbit period T sampled at t (both ends): the
+    discrete Fourier sum over the samples (the last, the first's repeat, left out), exact for
+    a periodic record with no window; zero where k is not a whole number."""
+    if k != int(k):
+        return 0.0
+    phase = np.exp(-2j * np.pi * k * (t[:-1] - t[0]) / T)
+    return float(2.0 * np.abs(np.mean(x[:-1] * phase)))
 
 
 def _failed(message, T, periods, t_wall) -> Orbit:

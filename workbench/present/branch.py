@@ -241,3 +241,57 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
                   "steady states only where the transient has died).  Both measured on this "
                   "machine, not side by side.", ""]
     return lines
+
+
+def period_doubling_finding(folder: Path) -> dict | None:
+    """Where the period-1 orbit of a continuation study's first branch (``folder`` its
+    results, :mod:`workbench.study.branches`) loses stability by a period doubling: the
+    parameter, its range, the first orbit's largest multiplier and the time constant it sets
+    (s), the last stable orbit's value before the doubling and the first unstable one's with
+    its multiplier, and the doubled branch's orbits, status and largest lines at f / 2 (tip,
+    cm; strain1) against the drive's; ``doubling`` None where the branch has none.  None where
+    the study has not run."""
+    folder = Path(folder)
+    summaries = sorted(folder.glob("*/summary.json"))
+    if not summaries or not (folder / "branches.parquet").is_file():
+        return None
+    summary = json.loads(summaries[0].read_text())
+    table = pd.read_parquet(folder / "branches.parquet")
+    main = table[table.branch == summary["label"]].reset_index(drop=True)
+    parameter = summary["definition"]["continuation"]["parameter"]
+    first = main.iloc[0]
+    period = 1.0 / float(summary["definition"]["excitation"]["freq_hz"]) \
+        if parameter == "force_n" else 1.0 / float(first[parameter])
+    out = {"parameter": parameter, "unit": B.PARAMETERS[parameter],
+           "start": float(first[parameter]), "end": float(main[parameter].iloc[-1]),
+           "status": summary["status"], "message": summary["message"],
+           "orbits": len(main), "first_stable": first.stability,
+           "first_multiplier": float(first.max_multiplier),
+           "time_constant_s": (-period / np.log(first.max_multiplier)
+                               if 0 < first.max_multiplier < 1 else None),
+           "doubling": None}
+    at = main.index[main.bifurcation == "period doubling"]
+    if not len(at):
+        return out
+    i = int(at[0])
+    before = main.iloc[:i][main.stability.iloc[:i] != "undetermined"]
+    doubled = [d for d in summary["doubled"]]
+    info = {"last_stable": float(before[parameter].iloc[-1]) if len(before) else None,
+            "first_unstable": float(main[parameter].iloc[i]),
+            "multiplier": float(main.max_multiplier.iloc[i]), "doubled": None}
+    if doubled:
+        d = doubled[0]
+        rows = table[table.branch == f"{summary['label']}/{d['folder']}"]
+        info["doubled"] = {"status": d["status"], "message": d["message"],
+                           "orbits": len(rows)}
+        if len(rows):
+            k = int(np.argmax(rows["strain1_h0.5"].to_numpy()))
+            info["doubled"].update(
+                range=(float(rows[parameter].min()), float(rows[parameter].max())),
+                stable=int(rows.stable.sum()),
+                tip_half_cm=float(rows["tip_h0.5_cm"].max()),
+                strain_half_over_drive=float(rows["strain1_h0.5"].iloc[k]
+                                             / rows["strain1_h1"].iloc[k]),
+                at=float(rows[parameter].iloc[k]))
+    out["doubling"] = info
+    return out
