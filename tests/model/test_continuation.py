@@ -54,10 +54,10 @@ def test_each_orbit_of_the_branch_is_the_orbit_found_alone(stuck_branch):
     assert np.allclose(np.abs(alone.deciding()), np.abs(orbit.deciding()), atol=1e-5)
 
 
-def _orbit(multipliers, grazing=False) -> Orbit:
+def _orbit(multipliers, grazing=False, error=1e-6) -> Orbit:
     mu = np.asarray(multipliers, complex)
     return Orbit("ok", "", 0.05, 1, np.zeros(18), 13, 0.0, 1, mu, bool(np.abs(mu).max() < 1),
-                 grazing, 1.0, {}, {}, 0.0, 0.0, len(mu))
+                 grazing, 1.0, {}, {}, 0.0, 0.0, len(mu), multiplier_error=error)
 
 
 @pytest.mark.parametrize("before, after, kind", [
@@ -70,6 +70,14 @@ def _orbit(multipliers, grazing=False) -> Orbit:
 def test_a_multiplier_leaving_the_unit_circle_names_the_bifurcation(before, after, kind):
     assert _bifurcation(_orbit(before), _orbit(after)) == kind
     assert _bifurcation(_orbit([0.5]), _orbit([0.5], grazing=True)) == "grazing"
+
+
+def test_a_multiplier_within_its_error_of_the_circle_names_nothing():
+    """-0.999 and -1.001 with an error estimate of 0.01 either side: no bifurcation is
+    claimed (the count outside the circle is not decided), nor without an estimate."""
+    assert _bifurcation(_orbit([-0.999, 0.5], error=0.01), _orbit([-1.001, 0.5])) == ""
+    assert _bifurcation(_orbit([-0.9, 0.5]), _orbit([-1.001, 0.5], error=0.01)) == ""
+    assert _bifurcation(_orbit([-0.9, 0.5]), _orbit([-1.1, 0.5], error=float("nan"))) == ""
 
 
 def test_a_branch_is_traced_downwards_too():

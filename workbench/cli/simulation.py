@@ -245,7 +245,7 @@ def value_or_range(text: str):
 
 def _cmd_continue(args) -> int:
     from ..model import drives
-    from ..model.continuation import branch_rows, continue_branch
+    from ..model.continuation import branch_rows, continue_branch, continue_doubled
     from ..model.orbit import Shooter
     from ..model.packing import JOINT
     from ..present.branch import write_branch
@@ -269,12 +269,20 @@ def _cmd_continue(args) -> int:
                       JOINT if args.joint == "locked" else (), parameter, args.monodromy)
     branch = continue_branch(shooter, lo, hi, on_orbit=lambda b: write_branch(b, out, p))
     rows = branch_rows(branch)
+    doubled = []
+    for i, kind in (branch.bifurcations if args.period_doubling else []):
+        if kind == "period doubling":
+            sub = out / f"doubled-{rows[i][parameter]:.4g}"
+            d = continue_doubled(shooter, branch, i, lo, hi,
+                                 on_orbit=lambda b, sub=sub: write_branch(b, sub, p))
+            doubled.append({"at": rows[i][parameter], "status": d.status,
+                            "message": d.message, "orbits": len(d.orbits), "out": str(sub)})
     summary = {"status": branch.status, "message": branch.message, "parameter": parameter,
                "range": [lo, hi], "orbits": len(rows),
                "stable": int(sum(r["stable"] for r in rows)),
                "bifurcations": [{"at": rows[i][parameter], "kind": k}
                                 for i, k in branch.bifurcations],
-               "wall_s": branch.wall_s, "out": str(out)}
+               "doubled": doubled, "wall_s": branch.wall_s, "out": str(out)}
     print(json_text(summary) if args.json else
           f"{branch.status}: {branch.message}; {len(rows)} orbits, {summary['stable']} stable, "
           f"{len(branch.bifurcations)} bifurcation(s); wrote {out}")
@@ -380,6 +388,9 @@ def add_parsers(sub) -> None:
                       help=f"the sine's amplitude (N; default {drives.DEFAULT_FORCE_N:g}), or "
                       "FROM:TO to continue over it (either way)")
     cont.add_argument("--out", help="output folder (default results/continue/<parameter>-FROM-TO)")
+    cont.add_argument("--period-doubling", action="store_true",
+                      help="at each period doubling also trace the branch of twice the period, "
+                      "into OUT/doubled-<value>/")
     cont.set_defaults(func=_cmd_continue)
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "

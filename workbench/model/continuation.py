@@ -23,10 +23,10 @@ the last (on the error scales).  The branch ends, with its status, when ds falls
 DS_MIN, when lambda passes the range's end, or when it folds back past its start (a range
 may run downwards: from 200 N to 40 N).
 
-At each orbit its multipliers are computed; between two orbits whose stability they decide
-(beyond their error estimate, :mod:`workbench.model.orbit`; orbits between them whose
-stability is undetermined are skipped) a change in the number of multipliers outside the
-unit circle is a bifurcation, named by the multiplier that crossed: through +1 a fold (a
+At each orbit its multipliers are computed; between two orbits whose number of multipliers
+outside the unit circle is decided (none within its error estimate of the circle,
+:mod:`workbench.model.orbit`; orbits between them where it is not are skipped) a change in
+that number is a bifurcation, named by the multiplier that crossed: through +1 a fold (a
 saddle-node), through -1 a period doubling, as a complex pair a Neimark-Sacker; an open gap
 whose minimum starts or stops touching zero, a grazing.
 
@@ -46,7 +46,8 @@ from typing import Callable
 
 import numpy as np
 
-from .orbit import Orbit, Shooter, error_scales, reduced_scales, stuck_direction
+from .orbit import (STABLE_MARGIN, Orbit, Shooter, error_scales, reduced_scales,
+                    stuck_direction)
 from .params import ParameterError
 from .regimes import contact_code
 
@@ -88,14 +89,28 @@ class Branch:
     wall_s: float = 0.0
 
 
+def outside_count(orbit: Orbit) -> int | None:
+    """How many of the orbit's deciding multipliers lie outside the unit circle, None where
+    that is not decided: a multiplier within its error estimate (or STABLE_MARGIN) of the
+    circle, or no error estimate (an orbit not found, a grazing one)."""
+    error = orbit.multiplier_error
+    if not np.isfinite(error) or not len(orbit.multipliers):
+        return None
+    mu = np.abs(orbit.deciding())
+    if np.any(np.abs(mu - 1.0) <= max(error, STABLE_MARGIN)):
+        return None
+    return int((mu > 1.0).sum())
+
+
 def _bifurcation(before: Orbit, after: Orbit) -> str:
-    """The kind of a change of stability between two orbits (module docstring), or ''."""
+    """The kind of a change of stability between two orbits (module docstring), or '' (also
+    where either's count of multipliers outside the unit circle is not decided)."""
     if before.grazing != after.grazing:
         return "grazing"
-    a, b = before.deciding(), after.deciding()
-    n_a, n_b = int((np.abs(a) > 1.0).sum()), int((np.abs(b) > 1.0).sum())
-    if n_a == n_b:
+    n_a, n_b = outside_count(before), outside_count(after)
+    if n_a is None or n_b is None or n_a == n_b:
         return ""
+    a, b = before.deciding(), after.deciding()
     outside = b if n_b > n_a else a                   # the side with the multiplier out
     crossed = outside[np.argmax(np.abs(outside))]
     if abs(crossed.imag) > 1e-6 * abs(crossed):
@@ -162,10 +177,10 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
                 ds /= 2.0
         new_value, new_orbit, iterations = accepted
         kind = ("grazing" if new_orbit.grazing != orbit.grazing else
-                _bifurcation(determined, new_orbit) if new_orbit.stable is not None else "")
+                _bifurcation(determined, new_orbit))
         if kind:
             branch.bifurcations.append((len(branch.orbits), kind))
-        if new_orbit.stable is not None:
+        if outside_count(new_orbit) is not None:
             determined = new_orbit
         branch.orbits.append((new_value, new_orbit))
         if iterations <= EASY:
