@@ -111,3 +111,21 @@ def test_every_block_says_what_it_is():
             assert language in (*RUN, "text", "toml"), f"{path.name}:{line} is tagged {language!r}"
         assert not indented_blocks(path), (path.name, indented_blocks(path))
     assert sum(b[0] in RUN for p in DOCS for b in blocks(p)) >= 8
+
+
+@pytest.mark.parametrize("path", DOCS, ids=lambda p: p.name)
+def test_every_study_example_and_file_loads(path):
+    """A ``toml`` block with a [study] table is a study that loads as written (and so is
+    every study file under studies/)."""
+    import tomllib
+    from workbench.study import definition as S
+    loaded = 0
+    for language, line, code in blocks(path):
+        if language == "toml" and code.lstrip().startswith("[study]"):
+            S.from_dict(tomllib.loads(code), source=f"{path.name}:{line}")
+            loaded += 1
+    if path.name == "usage.md":
+        assert loaded >= 1
+    if path.name == "README.md":
+        for study in sorted((ROOT / "studies").glob("*.toml")):
+            S.load(study)

@@ -133,19 +133,18 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
             continue
         s = json.loads(f.read_text())
         summaries.append((p, s))
-        parts = [(B.label(p), s)] + ([(f"{B.label(p)}/from-end", s["from_end"])]
-                                   if s["from_end"] else [])
-        for name, part in parts:
+        for k, seg in enumerate(s["segments"]):
+            name = B.label(p) if seg["folder"] == "." else f"{B.label(p)}/{seg['folder']}"
             rows = table[table.branch == name] if len(table) else table
-            bif = "; ".join(f"{b['kind']} at {b['at']:.5g}" for b in part["bifurcations"])
-            wall = part["wall_s"] if name != B.label(p) else s["wall_s"] - sum(
-                d["wall_s"] for d in [s["from_end"] or {"wall_s": 0.0}, *s["doubled"]])
-            lines.append(f"| [{name}]({name}/report.md) | {part['status']}: {part['message']} "
-                         f"| {part['orbits']} | {int(rows.stable.sum()) if len(rows) else 0} | "
-                         f"{bif or 'none'} | {wall:.0f} |")
-    if any(s["from_end"] for _, s in summaries):
-        lines += ["", "A branch that ends before its range's end (a fold back past its start, "
-                  "a step floor) is traced again from the range's other end (`from-end`)."]
+            bif = "; ".join(f"{b['kind']} at {b['at']:.5g}" for b in seg["bifurcations"])
+            lines.append(f"| [{name}]({name}/report.md) | {seg['status']}: {seg['message']} "
+                         f"| {seg['orbits']} | {int(rows.stable.sum()) if len(rows) else 0} | "
+                         f"{bif or 'none'} | {seg['wall_s']:.0f} |")
+    if any(len(s["segments"]) > 1 for _, s in summaries):
+        lines += ["", f"A branch that ends before its range's end starts anew "
+                  f"{100 * B.RESTART:g} % of the range beyond the farthest value it reached "
+                  "(`from-<value>`): a new segment, found by shooting there, not continued "
+                  "from the one before (the two may lie on different branches)."]
     doubled = [(s["label"], d) for _, s in summaries for d in s["doubled"]]
     if doubled:
         lines += ["", "Branches of twice the period, switched to at the period doublings "
@@ -194,7 +193,7 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
             lines += [f"### {B.label(p)}", "", "No stepped point inside the branch's range.", ""]
             continue
         write_atomic(beside, out / B.label(p) / "stepped_beside.parquet")
-        total_branch += s["wall_s"] - sum(d["wall_s"] for d in s["doubled"])   # from-end in
+        total_branch += sum(seg["wall_s"] for seg in s["segments"])
         ran = points[f"axis_{c.parameter}"].between(branch[c.parameter].min(),
                                                     branch[c.parameter].max())
         total_stepped += float(points.wall_s[ran].sum())

@@ -23,8 +23,10 @@ Each branch (:func:`workbench.model.continuation.continue_branch`) is written to
 (:mod:`workbench.present.branch`, which also writes the study's report) (``branch.parquet`` after
 every orbit, the figure and ``report.md`` at its end; ``summary.json`` marks it finished, so
 that a study run again resumes with the branches not yet finished, each from its start).
-A branch that ends before the range's end is traced again from that end
-(``<label>/from-end/``), and a doubled branch goes to ``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
+A branch that ends before the range's end is started anew a little beyond the farthest value
+it reached (RESTART; ``<label>/from-<value>/``: a new segment, found by shooting, which the
+report says is not continued from the last), and a doubled branch goes to
+``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
 holds every orbit of every branch, ``report.md`` the study's account.
 
 With ``compare``, each stepped point of that study (``results/<compare>/points.parquet``)
@@ -57,6 +59,12 @@ PARAMETERS = {"freq_hz": "Hz", "force_n": "N"}
 #: Up and down sweeps whose tip lines at one value differ by more than this fraction of the
 #: larger found different responses there (hysteresis: a jump between there and a neighbour).
 HYSTERESIS = 0.1
+#: A branch that ends before the range's end (a fold back past its start, a step floor, no
+#: orbit found at its start) is started anew this fraction of the range beyond the farthest
+#: value it reached (a new segment: found by shooting there, not continued from the last),
+#: at most MAX_SEGMENTS times.
+RESTART = 0.01
+MAX_SEGMENTS = 12
 #: [study] keys of a grid's runs, which a continuation study does not take.
 GRID_ONLY = ("duration_s", "window_s", "sweep", "save_series", "check_accuracy", "dt",
              "output_hz", "tol", "method", "initial")
@@ -190,9 +198,8 @@ def trace(study, point, folder: Path, write) -> dict:
         return _trace(study, point, folder, write)
     except Exception as exc:                           # noqa: BLE001 - kept in the summary
         summary = {"label": folder.name, "definition": definition(study, point),
-                   "status": "failed",
-                   "message": f"{type(exc).__name__}: {exc}", "orbits": 0, "wall_s": 0.0,
-                   "bifurcations": [], "from_end": None, "doubled": []}
+                   "status": "failed", "message": f"{type(exc).__name__}: {exc}",
+                   "orbits": 0, "wall_s": 0.0, "segments": [], "doubled": []}
         write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
         return summary
 
@@ -205,30 +212,27 @@ def _trace(study, point, folder: Path, write) -> dict:
     (folder / "summary.json").unlink(missing_ok=True)
     for old in folder.glob("**/branch.parquet"):         # an earlier definition's, or cut short
         old.unlink()
-    shooter = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
-                      c.monodromy)
-    branch = continue_branch(shooter, c.start, c.end,
-                             on_orbit=lambda b: write(b, folder, point.params))
+    direction = 1.0 if c.end > c.start else -1.0
+    step = RESTART * abs(c.end - c.start) * direction
+    segments, traced, start = [], [], c.start
+    while len(segments) < MAX_SEGMENTS and (start - c.end) * direction < 0:
+        sub = folder if not segments else folder / f"from-{start:.4g}"
+        shooter = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
+                          c.monodromy)
+        branch = continue_branch(shooter, start, c.end,
+                                 on_orbit=lambda b, sub=sub: write(b, sub, point.params))
+        segments.append({"folder": str(sub.relative_to(folder)), "start": start,
+                         **_account(branch)})
+        traced.append((branch, shooter))
+        if branch.status == "done":
+            break
+        values = [v for v, _ in branch.orbits] or [start]
+        start = (max(values) if direction > 0 else min(values)) + step
+    last = segments[-1]
     summary = {"label": folder.name, "definition": definition(study, point),
-               "status": branch.status, "message": branch.message,
-               "orbits": len(branch.orbits), "wall_s": branch.wall_s,
-               "bifurcations": [{"at": branch.orbits[i][0], "kind": k}
-                                for i, k in branch.bifurcations],
-               "from_end": None, "doubled": []}
-    traced = [(branch, shooter)]
-    if branch.status != "done":
-        back = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
-                       c.monodromy)
-        sub = folder / "from-end"
-        other = continue_branch(back, c.end, c.start,
-                                on_orbit=lambda b: write(b, sub, point.params))
-        summary["from_end"] = {"folder": sub.name, "status": other.status,
-                               "message": other.message, "orbits": len(other.orbits),
-                               "wall_s": other.wall_s,
-                               "bifurcations": [{"at": other.orbits[i][0], "kind": k}
-                                                for i, k in other.bifurcations]}
-        summary["wall_s"] += other.wall_s
-        traced.append((other, back))
+               "status": last["status"] if len(segments) == 1 or last["status"] == "done"
+               else f"{last['status']} (segment {len(segments)})",
+               "message": last["message"], "segments": segments, "doubled": []}
     if c.period_doubling:
         for parent, parent_shooter in traced:
             for i, kind in parent.bifurcations:
@@ -238,16 +242,19 @@ def _trace(study, point, folder: Path, write) -> dict:
                 doubled = continue_doubled(parent_shooter, parent, i, c.start, c.end,
                                            on_orbit=lambda b, sub=sub: write(
                                                b, sub, point.params))
-                summary["doubled"].append({"folder": sub.name, "status": doubled.status,
-                                           "message": doubled.message,
-                                           "orbits": len(doubled.orbits),
-                                           "wall_s": doubled.wall_s,
-                                           "bifurcations": [
-                                               {"at": doubled.orbits[i][0], "kind": k}
-                                               for i, k in doubled.bifurcations]})
-                summary["wall_s"] += doubled.wall_s
+                summary["doubled"].append({"folder": sub.name, **_account(doubled)})
+    summary["orbits"] = sum(x["orbits"] for x in segments)
+    summary["wall_s"] = sum(x["wall_s"] for x in [*segments, *summary["doubled"]])
     write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
     return summary
+
+
+def _account(branch) -> dict:
+    """A traced branch's end, orbits, wall time and bifurcations, for the summary."""
+    return {"status": branch.status, "message": branch.message, "orbits": len(branch.orbits),
+            "wall_s": branch.wall_s,
+            "bifurcations": [{"at": branch.orbits[i][0], "kind": k}
+                             for i, k in branch.bifurcations]}
 
 
 def collect(study, out: Path) -> pd.DataFrame:
