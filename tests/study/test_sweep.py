@@ -14,7 +14,7 @@ from workbench.study import definition as S
 from workbench.study import sweep as W
 from workbench.present.report import make_report, series_tags
 from workbench.model.params import ParameterError
-from workbench.study.store import read_runs
+from workbench.study.store import WATCHDOG_S, read_runs
 
 from small_studies import CHIRP, SMALL
 
@@ -376,7 +376,7 @@ def test_kill_9_of_the_sweep_leaves_no_worker_computing(tmp_path):
         time.sleep(2.0)                                   # the workers are computing
         os.kill(proc.pid, signal.SIGKILL)                 # the sweep only, not its group
         proc.wait()
-        deadline = time.time() + 10 * W.WATCHDOG_S + 5
+        deadline = time.time() + 10 * WATCHDOG_S + 5
         while time.time() < deadline and any(_alive(w) for w in workers):
             time.sleep(0.2)
         assert not any(_alive(w) for w in workers), "workers computed on after the sweep died"

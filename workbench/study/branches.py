@@ -50,7 +50,7 @@ import pandas as pd
 
 from ..model.limits import MONODROMY_METHODS
 from ..model.params import ParameterError
-from .store import StudyLock, log_run, update_run, write_atomic, write_text_atomic
+from .store import StudyLock, log_run, update_run, watch_sweep, write_atomic, write_text_atomic
 
 #: The table's keys.
 KEYS = {"parameter", "from", "to", "periods", "period_doubling", "compare", "monodromy"}
@@ -161,7 +161,8 @@ def run_branches(study, write, results: str | Path = "results", jobs: int = 2,
             state = "failed"
             try:
                 Parallel(n_jobs=min(jobs, len(todo)))(
-                    delayed(trace)(study, p, out / label(p), write) for p in todo)
+                    delayed(trace)(study, p, out / label(p), write, os.getpid())
+                    for p in todo)
                 state = "done"
             except KeyboardInterrupt:
                 state = "interrupted"
@@ -191,9 +192,13 @@ def finished(study, point, out: Path) -> bool:
         return False
 
 
-def trace(study, point, folder: Path, write) -> dict:
+def trace(study, point, folder: Path, write, sweep_pid: int | None = None) -> dict:
     """One branch (and its doubled branches): written to ``folder``; its summary (status
-    "failed" with the error where tracing raised: the other branches go on)."""
+    "failed" with the error where tracing raised: the other branches go on).  ``sweep_pid``:
+    the study's process; a worker stops itself once that is gone (a killed study leaves no
+    worker tracing)."""
+    if sweep_pid is not None and sweep_pid != os.getpid():
+        watch_sweep(sweep_pid)
     try:
         return _trace(study, point, folder, write)
     except Exception as exc:                           # noqa: BLE001 - kept in the summary

@@ -1,4 +1,5 @@
-"""A study's results folder: atomic writes, damaged files set aside, the run log, the lock.
+"""A study's results folder: atomic writes, damaged files set aside, the run log, the lock, the
+watchdog that stops a worker whose sweep has gone.
 
     results/<study>/points/<key>.parquet   one row per finished point
     results/<study>/runs.json              one entry per sweep invocation
@@ -139,3 +140,28 @@ class StudyLock:
         fcntl.flock(self.handle, fcntl.LOCK_UN)
         self.handle.close()
         return False
+
+
+#: A worker whose sweep process is gone stops within this many seconds.
+WATCHDOG_S = 1.0
+_WATCHED: set = set()
+
+
+def watch_sweep(pid: int) -> None:
+    """In a worker: a daemon thread that ends the process once ``pid`` has gone."""
+    if pid in _WATCHED:
+        return
+    _WATCHED.add(pid)
+    import threading
+
+    def watch():
+        while True:
+            time.sleep(WATCHDOG_S)
+            try:
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:
+                pass
+
+    threading.Thread(target=watch, name="sweep-watchdog", daemon=True).start()

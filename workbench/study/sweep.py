@@ -40,11 +40,10 @@ from ..model.drives import excitation_array
 from ..model.methods import METHODS
 from ..model.step_policy import default_dt
 from ..model.simulate import simulate
-from .store import StudyLock, log_run, read_point, read_runs, update_run, write_atomic
+from .store import (StudyLock, log_run, read_point, read_runs, update_run, watch_sweep,
+                    write_atomic)
 from .definition import Point, Study, load
 
-#: A worker whose sweep process is gone stops within this many seconds.
-WATCHDOG_S = 1.0
 
 #: Seconds a sweep spends before its first point: the workers' start, their imports and
 #: the kernels loaded from the cache (2.9 s of the docs' 2-point example's 3.3 s, 2 workers).
@@ -156,7 +155,7 @@ def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path,
     itself when that process is gone (a killed sweep leaves no worker).
     """
     if sweep_pid is not None and sweep_pid != os.getpid():
-        _watch(sweep_pid)
+        watch_sweep(sweep_pid)
     rows = []
     state = estimate = None
     for point, key in zip(chain, keys):
@@ -173,29 +172,6 @@ def run_chain(study: Study, chain: list[Point], keys: list[str], out: Path,
             if study.limits is not None and row.get("level_met"):
                 estimate = float(row["force_n_used"])
     return rows
-
-
-_WATCHED: set = set()
-
-
-def _watch(pid: int) -> None:
-    """In a worker: a daemon thread that ends the process once ``pid`` has gone."""
-    if pid in _WATCHED:
-        return
-    _WATCHED.add(pid)
-    import threading
-
-    def watch():
-        while True:
-            time.sleep(WATCHDOG_S)
-            try:
-                os.kill(pid, 0)
-            except ProcessLookupError:
-                os._exit(1)
-            except PermissionError:
-                pass
-
-    threading.Thread(target=watch, name="sweep-watchdog", daemon=True).start()
 
 
 def estimated_cost(study: Study, chain: list[Point]) -> float:
