@@ -136,9 +136,13 @@ def test_a_continuation_study_traces_writes_and_compares(tiny_study):
     up, down = beside.iloc[0], beside.iloc[1]
     assert up.orbits_there == 1 and up.orbit_stable and up.difference_rel < 1e-4
     assert down.difference_rel == pytest.approx(0.3 / 1.3, rel=1e-3)
+    # log(1e-3) / log|mu|: the periods a run takes to come within 1e-3 of the orbit
+    assert up.settle_periods == pytest.approx(np.log(1e-3) / np.log(up.orbit_max_multiplier))
+    assert 0.99 < up.orbit_max_multiplier < 1.0
     report = (out / "report.md").read_text()
     assert "| none | none | 1 | no |" in report          # the jump at 20 Hz: no fold brackets it
     assert "points at the same axis values 5 s" in report   # 2 s + 3 s: 25 Hz is outside
+    assert "At the same accuracy: a run settles onto a stable orbit" in report
     assert (out / "gap_mm-1.016" / "stepped_beside.png").is_file()
 
 

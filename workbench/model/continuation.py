@@ -320,9 +320,8 @@ def doubled_start(shooter: Shooter, branch: Branch, index: int):
         for offset in SWITCH_OFFSETS:
             guess = manifold.project(manifold.move(orbit.state, offset * v))
             found = periodic_orbit(shooter.params, ex, 2 * shooter.periods,
-                                   guess=(guess, orbit.regime), max_newton=MAX_CORRECTOR,
-                                   fixed=shooter.fixed, phases=(shooter.phase,),
-                                   monodromy=shooter.method)
+                                   guess=(guess, orbit.regime), fixed=shooter.fixed,
+                                   phases=(shooter.phase,), monodromy=shooter.method)
             if found.status in ("ok", "grazing") and _moved_by_period(shooter, found, ex) \
                     > SAME_ORBIT:
                 return value, found, side

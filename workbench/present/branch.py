@@ -175,7 +175,7 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
               "over the period); `steady` is the stepped run's own indicator (the tip RMS of "
               "its last two windows within its tolerance), the Poincaré spread the range of "
               "its tip at the drive's phase 0 over the window (zero on a period-1 orbit).", ""]
-    total_branch, total_stepped = 0.0, 0.0
+    total_branch, total_stepped, orbits_traced, settle_s, settle_wall = 0.0, 0.0, 0, [], []
     for p, s in summaries:
         mask = np.ones(len(stepped), bool)
         for k, v in p.values.items():
@@ -194,6 +194,11 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
             continue
         write_atomic(beside, out / B.label(p) / "stepped_beside.parquet")
         total_branch += sum(seg["wall_s"] for seg in s["segments"])
+        orbits_traced += sum(seg["orbits"] for seg in s["segments"])
+        speed = points.simulated_s.sum() / points.wall_s.sum()     # simulated s per wall s
+        settle = beside.settle_periods.to_numpy(float) / beside[c.parameter].to_numpy(float)
+        settle_s += [x for x in settle if np.isfinite(x)]
+        settle_wall += [x / speed for x in settle if np.isfinite(x)]
         ran = points[f"axis_{c.parameter}"].between(branch[c.parameter].min(),
                                                     branch[c.parameter].max())
         total_stepped += float(points.wall_s[ran].sum())
@@ -239,6 +244,15 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
                   f"{stepped.tol.iloc[0]:.0e}, {stepped.simulated_s.iloc[0]:g} s a step, "
                   "steady states only where the transient has died).  Both measured on this "
                   "machine, not side by side.", ""]
+        if settle_s:
+            lines += [f"At the same accuracy: a run settles onto a stable orbit to "
+                      f"{B.SETTLE:g} of its distance in log({B.SETTLE:g}) / log|μ| periods (|μ| "
+                      "the orbit's largest multiplier): at the stepped points with a stable "
+                      f"orbit, {np.median(settle_s):.0f} s of simulated time (median; "
+                      f"{min(settle_s):.0f}–{max(settle_s):.0f} s), {np.median(settle_wall):.0f} "
+                      "s of wall at the stepped runs' own speed, per point, against "
+                      f"{total_branch / max(orbits_traced, 1):.1f} s per orbit on the branches "
+                      f"(each to a residual of 1e-7 of the error scales).", ""]
     return lines
 
 

@@ -65,6 +65,9 @@ HYSTERESIS = 0.1
 #: at most MAX_SEGMENTS times.
 RESTART = 0.01
 MAX_SEGMENTS = 12
+#: A run settles onto a stable orbit, to this fraction of its initial distance, in
+#: log(SETTLE) / log|mu| periods (|mu| its slowest multiplier): the brute force's cost.
+SETTLE = 1e-3
 #: [study] keys of a grid's runs, which a continuation study does not take.
 GRID_ONLY = ("duration_s", "window_s", "sweep", "save_series", "check_accuracy", "dt",
              "output_hz", "tol", "method", "initial")
@@ -303,8 +306,9 @@ def orbits_at(table: pd.DataFrame, parameter: str, value: float,
 def stepped_beside(branch: pd.DataFrame, stepped: pd.DataFrame, parameter: str
                    ) -> pd.DataFrame:
     """Each stepped point beside the branch (module docstring): its tip line, the nearest
-    orbit's there and whether that orbit is stable, their difference relative to the
-    stepped one, and the stepped run's own steadiness."""
+    orbit's there, whether that orbit is stable and its largest multiplier, their difference
+    relative to the stepped one, the periods a run takes to settle onto a stable orbit
+    (SETTLE), and the stepped run's own steadiness."""
     rows = []
     lo, hi = branch[parameter].min(), branch[parameter].max()
     for _, s in stepped.iterrows():
@@ -318,9 +322,13 @@ def stepped_beside(branch: pd.DataFrame, stepped: pd.DataFrame, parameter: str
                if len(s.tip_poincare) else np.nan,
                "orbits_there": len(there), "stable_orbits_there": sum(st for _, st in there)}
         if there:
-            y, st = min(there, key=lambda o: abs(o[0] - s.tip_h1))
-            row.update(orbit_tip_h1_cm=y, orbit_stable=st,
-                       difference_rel=abs(y - s.tip_h1) / max(abs(s.tip_h1), 1e-12))
+            multipliers = [m for m, _ in orbits_at(branch, parameter, value, "max_multiplier")]
+            k = min(range(len(there)), key=lambda j: abs(there[j][0] - s.tip_h1))
+            (y, st), mu = there[k], multipliers[k]
+            row.update(orbit_tip_h1_cm=y, orbit_stable=st, orbit_max_multiplier=mu,
+                       difference_rel=abs(y - s.tip_h1) / max(abs(s.tip_h1), 1e-12),
+                       settle_periods=(np.log(SETTLE) / np.log(mu) if st and 0 < mu < 1
+                                       else np.nan))
         rows.append(row)
     return pd.DataFrame(rows)
 
