@@ -41,7 +41,6 @@ from __future__ import annotations
 import json
 import os
 import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -50,7 +49,7 @@ import pandas as pd
 
 from ..model.limits import MONODROMY_METHODS
 from ..model.params import ParameterError
-from .store import StudyLock, log_run, update_run, watch_sweep, write_atomic, write_text_atomic
+from .store import StudyLock, logged_run, watch_sweep, write_atomic, write_text_atomic
 
 #: The table's keys.
 KEYS = {"parameter", "from", "to", "periods", "period_doubling", "compare", "monodromy"}
@@ -157,21 +156,10 @@ def run_branches(study, write, results: str | Path = "results", jobs: int = 2,
             if progress:
                 print(f"workbench: {study.name}: {len(todo)} of {study.n_points} branches to "
                       f"trace on {min(jobs, len(todo))} worker(s)", file=sys.stderr)
-            t0 = time.perf_counter()
-            index = log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                                  "branches_run": len(todo), "jobs": jobs, "pid": os.getpid(),
-                                  "state": "running"})
-            state = "failed"
-            try:
+            with logged_run(out, {"branches_run": len(todo), "jobs": jobs}):
                 Parallel(n_jobs=min(jobs, len(todo)))(
                     delayed(trace)(study, p, out / label(p), write, os.getpid())
                     for p in todo)
-                state = "done"
-            except KeyboardInterrupt:
-                state = "interrupted"
-                raise
-            finally:
-                update_run(out, index, {"state": state, "wall_s": time.perf_counter() - t0})
         table = collect(study, out)
         write_atomic(table, out / "branches.parquet")
     return table

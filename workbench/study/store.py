@@ -16,6 +16,7 @@ a sweep killed without warning is still on record.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -104,6 +105,24 @@ def update_run(out: Path, index: int, changes: dict) -> None:
     else:
         runs.append(changes)
     write_text_atomic(json.dumps(runs, indent=1) + "\n", out / "runs.json")
+
+
+@contextlib.contextmanager
+def logged_run(out: Path, entry: dict):
+    """An invocation on record in runs.json while its block runs: ``entry`` with its start
+    and process, "running", then "done", "interrupted" or "failed" and its wall time."""
+    t0 = time.perf_counter()
+    index = log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **entry,
+                          "pid": os.getpid(), "state": "running"})
+    state = "failed"
+    try:
+        yield
+        state = "done"
+    except KeyboardInterrupt:
+        state = "interrupted"
+        raise
+    finally:
+        update_run(out, index, {"state": state, "wall_s": time.perf_counter() - t0})
 
 
 class StudyLock:

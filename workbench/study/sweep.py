@@ -40,8 +40,7 @@ from ..model.drives import excitation_array
 from ..model.methods import METHODS
 from ..model.step_policy import default_dt
 from ..model.simulate import simulate
-from .store import (StudyLock, log_run, read_point, read_runs, update_run, watch_sweep,
-                    write_atomic)
+from .store import StudyLock, logged_run, read_point, read_runs, watch_sweep, write_atomic
 from .definition import Point, Study, load
 
 
@@ -264,20 +263,9 @@ def run_study(study: Study, results: str | Path = "results", jobs: int = 2,
                       f"{p['steps']:.3g} steps, about {p['expected_wall_s']:.0f} s on {jobs} "
                       "worker(s)", file=sys.stderr)
             steps = sum(estimated_cost(study, c) for c, _ in todo)
-            t0 = time.perf_counter()
-            index = log_run(out, {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                                  "points_run": n_points, "steps": steps, "jobs": jobs,
-                                  "scheduler": scheduler, "pid": os.getpid(),
-                                  "state": "running"})
-            state = "failed"
-            try:
+            with logged_run(out, {"points_run": n_points, "steps": steps, "jobs": jobs,
+                                  "scheduler": scheduler}):
                 _execute(study, todo, out, jobs, scheduler, progress, n_points)
-                state = "done"
-            except KeyboardInterrupt:
-                state = "interrupted"
-                raise
-            finally:
-                update_run(out, index, {"state": state, "wall_s": time.perf_counter() - t0})
         rows = []
         for k in keys:
             for key in k:
