@@ -6,8 +6,8 @@ at phase 0 on its regime's manifold) and the parameter lambda (Hz or N), both on
 (the error scales of z, the range of lambda), u = (z / d, lambda / range).  From an orbit u0
 with unit tangent t0 (the null vector of [J - I, dR/dlambda], oriented along the secant
 from the orbit before, in the full state, so that a change of reduced coordinates does not
-turn it round; the first towards the range's end), the predictor is u0 + ds t0 and the corrector Newton's
-method on
+turn it round; the first towards the range's end), the predictor is u0 + ds t0 and the
+corrector Newton's method on
 
     R(z, lambda) = Phi(x(z), lambda) - x(z) = 0,    t0 . (u - u0) - ds = 0,
 
@@ -139,7 +139,7 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         return _done(branch, t0, on_orbit)
     shooter.phase = start.phase
     value, orbit = lo, start
-    determined = start               # the last orbit whose stability the multipliers decide
+    determined = start               # the last orbit whose count outside the circle is decided
     branch.orbits.append((value, orbit))
     while len(branch.orbits) < MAX_ORBITS:
         if on_orbit:
