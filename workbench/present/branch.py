@@ -133,7 +133,9 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
             continue
         s = json.loads(f.read_text())
         summaries.append((p, s))
-        for k, seg in enumerate(s["segments"]):
+        if not s["segments"]:
+            lines.append(f"| {B.label(p)} | {s['status']}: {s['message']} | 0 | 0 | none | 0 |")
+        for seg in s["segments"]:
             name = B.label(p) if seg["folder"] == "." else f"{B.label(p)}/{seg['folder']}"
             rows = table[table.branch == name] if len(table) else table
             bif = "; ".join(f"{b['kind']} at {b['at']:.5g}" for b in seg["bifurcations"])
