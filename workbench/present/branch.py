@@ -128,10 +128,10 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
     summaries = []
     for p in study.points:
         f = out / B.label(p) / "summary.json"
-        if not f.is_file():
-            lines.append(f"| {B.label(p)} | not finished | | | | |")
+        s = json.loads(f.read_text()) if f.is_file() else B.cut_short(p, table, c.parameter)
+        if s is None:
+            lines.append(f"| {B.label(p)} | not traced | 0 | 0 | none | |")
             continue
-        s = json.loads(f.read_text())
         summaries.append((p, s))
         if not s["segments"]:
             lines.append(f"| {B.label(p)} | {s['status']}: {s['message']} | 0 | 0 | none | 0 |")
@@ -141,7 +141,10 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
             bif = "; ".join(f"{b['kind']} at {b['at']:.5g}" for b in seg["bifurcations"])
             lines.append(f"| [{name}]({name}/report.md) | {seg['status']}: {seg['message']} "
                          f"| {seg['orbits']} | {int(rows.stable.sum()) if len(rows) else 0} | "
-                         f"{bif or 'none'} | {seg['wall_s']:.0f} |")
+                         f"{bif or 'none'} | {seg['wall_s']:.0f} |".replace("| nan |", "| — |"))
+    if any(s.get("interrupted") for _, s in summaries):
+        lines += ["", "A branch marked interrupted was cut short before it finished: the "
+                  "orbits on disk are reported, its wall time is not known."]
     if any(len(s["segments"]) > 1 for _, s in summaries):
         lines += ["", f"A branch that ends before its range's end starts anew "
                   f"{100 * B.RESTART:g} % of the range beyond the farthest value it reached "
@@ -195,15 +198,16 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
             lines += [f"### {B.label(p)}", "", "No stepped point inside the branch's range.", ""]
             continue
         write_atomic(beside, out / B.label(p) / "stepped_beside.parquet")
-        total_branch += sum(seg["wall_s"] for seg in s["segments"])
-        orbits_traced += sum(seg["orbits"] for seg in s["segments"])
-        speed = points.simulated_s.sum() / points.wall_s.sum()     # simulated s per wall s
-        settle = beside.settle_periods.to_numpy(float) / beside[c.parameter].to_numpy(float)
-        settle_s += [x for x in settle if np.isfinite(x)]
-        settle_wall += [x / speed for x in settle if np.isfinite(x)]
-        ran = points[f"axis_{c.parameter}"].between(branch[c.parameter].min(),
-                                                    branch[c.parameter].max())
-        total_stepped += float(points.wall_s[ran].sum())
+        if not s.get("interrupted"):                   # a cut-short branch has no wall time
+            total_branch += sum(seg["wall_s"] for seg in s["segments"])
+            orbits_traced += sum(seg["orbits"] for seg in s["segments"])
+            speed = points.simulated_s.sum() / points.wall_s.sum()   # simulated s per wall s
+            settle = beside.settle_periods.to_numpy(float) / beside[c.parameter].to_numpy(float)
+            settle_s += [x for x in settle if np.isfinite(x)]
+            settle_wall += [x / speed for x in settle if np.isfinite(x)]
+            ran = points[f"axis_{c.parameter}"].between(branch[c.parameter].min(),
+                                                        branch[c.parameter].max())
+            total_stepped += float(points.wall_s[ran].sum())
         lines += [f"### {B.label(p)}", "",
                   "| value | sweep | stepped tip_h1 (cm) | steady | Poincaré spread (cm) | "
                   "orbits there (stable) | nearest orbit (cm) | its stability | difference |",

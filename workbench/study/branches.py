@@ -25,8 +25,8 @@ every orbit, the figure and ``report.md`` at its end; ``summary.json`` marks it 
 that a study run again resumes with the branches not yet finished, each from its start).
 A branch that ends before the range's end is started anew a little beyond the farthest value
 it reached (RESTART; ``<label>/from-<value>/``: a new segment, found by shooting, which the
-report says is not continued from the last), and a doubled branch goes to
-``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
+report says is not continued from the last), and a doubled branch (at the first MAX_DOUBLED
+period doublings where the orbit loses its stability) goes to ``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
 holds every orbit of every branch, ``report.md`` the study's account.
 
 With ``compare``, each stepped point of that study (``results/<compare>/points.parquet``)
@@ -64,6 +64,9 @@ HYSTERESIS = 0.1
 #: at most MAX_SEGMENTS times.
 RESTART = 0.01
 MAX_SEGMENTS = 12
+#: The doubled branches traced per branch: at the first MAX_DOUBLED period doublings where the
+#: orbit loses its stability (a multiplier leaving the unit circle through -1).
+MAX_DOUBLED = 4
 #: A run settles onto a stable orbit, to this fraction of its initial distance, in
 #: log(SETTLE) / log|mu| periods (|mu| its slowest multiplier): the brute force's cost.
 SETTLE = 1e-3
@@ -230,15 +233,16 @@ def _trace(study, point, folder: Path, write) -> dict:
                else f"{last['status']} (segment {len(segments)})",
                "message": last["message"], "segments": segments, "doubled": []}
     if c.period_doubling:
-        for parent, parent_shooter in traced:
-            for i, kind in parent.bifurcations:
-                if kind != "period doubling":
-                    continue
-                sub = folder / f"doubled-{parent.orbits[i][0]:.4g}"
-                doubled = continue_doubled(parent_shooter, parent, i, c.start, c.end,
-                                           on_orbit=lambda b, sub=sub: write(
-                                               b, sub, point.params))
-                summary["doubled"].append({"folder": sub.name, **_account(doubled)})
+        doublings = [(parent, parent_shooter, i) for parent, parent_shooter in traced
+                     for i, kind in parent.bifurcations
+                     if kind == "period doubling" and parent.orbits[i][1].stable is not True]
+        for parent, parent_shooter, i in doublings[:MAX_DOUBLED]:
+            sub = folder / f"doubled-{parent.orbits[i][0]:.4g}"
+            doubled = continue_doubled(parent_shooter, parent, i, c.start, c.end,
+                                       on_orbit=lambda b, sub=sub: write(b, sub, point.params))
+            summary["doubled"].append({"folder": sub.name, **_account(doubled)})
+        summary["doublings_not_traced"] = [parent.orbits[i][0]
+                                           for parent, _, i in doublings[MAX_DOUBLED:]]
     summary["orbits"] = sum(x["orbits"] for x in segments)
     summary["wall_s"] = sum(x["wall_s"] for x in [*segments, *summary["doubled"]])
     write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
@@ -267,6 +271,30 @@ def collect(study, out: Path) -> pd.DataFrame:
             t.insert(0, "branch", str(f.parent.relative_to(out)))
             tables.append(t)
     return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+
+
+def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
+    """The summary of a branch whose tracing was cut short (no ``summary.json``) from the
+    orbits on disk (``table``, :func:`collect`): its segments and doubled branches, status
+    "interrupted", no wall times; None where it has no orbit on disk."""
+    name = label(point)
+    mine = table[(table.branch == name) | table.branch.str.startswith(name + "/")] \
+        if len(table) else table
+    if not len(mine):
+        return None
+    segments, doubled = [], []
+    for branch, rows in mine.groupby("branch", sort=False):
+        folder = "." if branch == name else branch[len(name) + 1:]
+        marked = rows[rows.bifurcation != ""]
+        entry = {"folder": folder, "status": "interrupted",
+                 "message": "cut short: the orbits on disk", "orbits": len(rows),
+                 "wall_s": float("nan"),
+                 "bifurcations": [{"at": float(v), "kind": k}
+                                  for v, k in zip(marked[parameter], marked.bifurcation)]}
+        (doubled if folder.startswith("doubled-") else segments).append(entry)
+    return {"label": name, "status": "interrupted", "message": "cut short",
+            "segments": segments, "doubled": doubled, "interrupted": True,
+            "orbits": sum(x["orbits"] for x in segments), "wall_s": float("nan")}
 
 
 def orbits_at(table: pd.DataFrame, parameter: str, value: float,
