@@ -158,3 +158,20 @@ def test_a_continuation_study_run_again_traces_nothing_and_a_changed_one_again(t
     assert json.loads(out.read_text())["definition"]["continuation"]["end"] == 19.8
     table = pd.read_parquet(root / "res" / "tiny_branch" / "branches.parquet")
     assert table.freq_hz.max() < 20.0
+
+
+def test_a_study_cut_short_reports_the_orbits_on_disk(tiny_study, tmp_path):
+    """Without the branch's summary (the study killed while tracing), the report lists the
+    orbits on disk as interrupted and still sets the stepped points beside them."""
+    import shutil
+    root, _, _ = tiny_study
+    res = tmp_path / "res"
+    shutil.copytree(root / "res", res)
+    (res / "tiny_branch" / "gap_mm-1.016" / "summary.json").unlink()
+    (root / "tiny.toml").write_text(TINY)
+    assert cli.main(["report", str(root / "tiny.toml"), "--results", str(res)]) == 0
+    report = (res / "tiny_branch" / "report.md").read_text()
+    orbits = len(pd.read_parquet(res / "tiny_branch" / "gap_mm-1.016" / "branch.parquet"))
+    assert f"| interrupted: cut short: the orbits on disk | {orbits} |" in report
+    assert "## The stepped study `fake_stepped` beside the branches" in report
+    assert "At the same accuracy" not in report                 # no wall time to count
