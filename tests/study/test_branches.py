@@ -70,17 +70,20 @@ def _branch(values, amplitudes, stable, folds=()):
 
 def test_the_orbits_at_a_frequency_are_read_off_every_segment_of_a_folded_branch():
     """An S-shaped branch (two folds) has three orbits between its folds; linear between the
-    orbits that bracket the frequency, stable where both are."""
+    orbits that bracket the frequency, their stability where both agree."""
     branch = _branch([10.0, 12.0, 11.0, 13.0], [1.0, 3.0, 5.0, 9.0], [True, True, False, True],
                      folds=(12.0, 11.0))
     there = B.orbits_at(branch, "freq_hz", 11.5)
-    assert sorted(there) == [(2.5, True), (4.0, False), (6.0, False)]
-    assert B.orbits_at(branch, "freq_hz", 10.0) == [(1.0, True)]
+    assert sorted(there) == [(2.5, "stable"), (4.0, "changes"), (6.0, "changes")]
+    assert B.orbits_at(branch, "freq_hz", 10.0) == [(1.0, "stable")]
     assert B.orbits_at(branch, "freq_hz", 13.5) == []
     two = pd.concat([branch.assign(branch="a"), _branch([10.0, 14.0], [0.5, 0.5], [True, True])
                      .assign(branch="b")])
-    assert (0.5, True) in B.orbits_at(two, "freq_hz", 11.5) and len(B.orbits_at(
+    assert (0.5, "stable") in B.orbits_at(two, "freq_hz", 11.5) and len(B.orbits_at(
         two, "freq_hz", 11.5)) == 4
+    branch["stability"] = ["stable", "undetermined", "unstable", "unstable"]
+    assert sorted(B.orbits_at(branch, "freq_hz", 11.5)) == [
+        (2.5, "undetermined"), (4.0, "undetermined"), (6.0, "unstable")]
 
 
 def test_a_jump_of_the_stepped_sweep_is_set_between_the_folds():
@@ -134,7 +137,7 @@ def test_a_continuation_study_traces_writes_and_compares(tiny_study):
     beside = pd.read_parquet(out / "gap_mm-1.016" / "stepped_beside.parquet")
     assert list(beside.direction) == ["up", "down"]          # 25 Hz is outside the range
     up, down = beside.iloc[0], beside.iloc[1]
-    assert up.orbits_there == 1 and up.orbit_stable and up.difference_rel < 1e-4
+    assert up.orbits_there == 1 and up.orbit_stability == "stable" and up.difference_rel < 1e-4
     assert down.difference_rel == pytest.approx(0.3 / 1.3, rel=1e-3)
     # log(1e-3) / log|mu|: the periods a run takes to come within 1e-3 of the orbit
     assert up.settle_periods == pytest.approx(np.log(1e-3) / np.log(up.orbit_max_multiplier))

@@ -214,7 +214,7 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
                   "|---|---|---|---|---|---|---|---|---|"]
         for _, r in beside.iterrows():
             near = ("| — | — | — |" if not r.orbits_there else
-                    f"| {r.orbit_tip_h1_cm:.4f} | {'stable' if r.orbit_stable else 'unstable'}"
+                    f"| {r.orbit_tip_h1_cm:.4f} | {r.orbit_stability}"
                     f" | {100 * r.difference_rel:.2f} % |")
             lines.append(f"| {r[c.parameter]:g} | {r.direction} | {r.stepped_tip_h1_cm:.4f} | "
                          f"{'yes' if r.stepped_steady else 'no'} | "

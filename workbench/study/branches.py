@@ -298,24 +298,28 @@ def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
 
 
 def orbits_at(table: pd.DataFrame, parameter: str, value: float,
-              column: str = "tip_h1_cm") -> list[tuple[float, bool]]:
+              column: str = "tip_h1_cm") -> list[tuple[float, str]]:
     """The orbits at ``value`` of the parameter on every branch of ``table`` (told apart by
-    its ``branch`` column, if any): (``column``, stable) on each segment between two orbits
-    that bracket it, linear between them (stable where both are)."""
+    its ``branch`` column, if any): (``column``, stability) on each segment between two
+    orbits that bracket it, linear between them; the stability the two orbits' where they
+    agree, "undetermined" where either's is, else "changes" (a bifurcation between)."""
     groups = table.groupby("branch", sort=False) if "branch" in table else [("", table)]
     found = []
     for _, part in groups:
         x = part[parameter].to_numpy(float)
         y = part[column].to_numpy(float)
-        stable = part.stable.to_numpy(bool)
+        word = (part.stability.to_numpy() if "stability" in part else
+                np.where(part.stable.to_numpy(bool), "stable", "unstable"))
         for i in range(len(x) - 1):
             lo, hi = sorted((x[i], x[i + 1]))
             if lo < value <= hi or (lo == value and i == 0):
                 w = (value - x[i]) / (x[i + 1] - x[i])
+                pair = {word[i], word[i + 1]}
                 found.append((float(y[i] + w * (y[i + 1] - y[i])),
-                              bool(stable[i] and stable[i + 1])))
+                              word[i] if len(pair) == 1 else
+                              "undetermined" if "undetermined" in pair else "changes"))
         if len(x) == 1 and x[0] == value:
-            found.append((float(y[0]), bool(stable[0])))
+            found.append((float(y[0]), str(word[0])))
     return found
 
 
@@ -336,15 +340,16 @@ def stepped_beside(branch: pd.DataFrame, stepped: pd.DataFrame, parameter: str
                "stepped_steady": bool(s.steady), "stepped_steady_change": s.steady_change,
                "stepped_poincare_spread_cm": float(np.ptp(s.tip_poincare))
                if len(s.tip_poincare) else np.nan,
-               "orbits_there": len(there), "stable_orbits_there": sum(st for _, st in there)}
+               "orbits_there": len(there),
+               "stable_orbits_there": sum(st == "stable" for _, st in there)}
         if there:
             multipliers = [m for m, _ in orbits_at(branch, parameter, value, "max_multiplier")]
             k = min(range(len(there)), key=lambda j: abs(there[j][0] - s.tip_h1))
             (y, st), mu = there[k], multipliers[k]
-            row.update(orbit_tip_h1_cm=y, orbit_stable=st, orbit_max_multiplier=mu,
+            row.update(orbit_tip_h1_cm=y, orbit_stability=st, orbit_max_multiplier=mu,
                        difference_rel=abs(y - s.tip_h1) / max(abs(s.tip_h1), 1e-12),
-                       settle_periods=(np.log(SETTLE) / np.log(mu) if st and 0 < mu < 1
-                                       else np.nan))
+                       settle_periods=(np.log(SETTLE) / np.log(mu)
+                                       if st == "stable" and 0 < mu < 1 else np.nan))
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -368,5 +373,5 @@ def jumps_and_folds(beside: pd.DataFrame, branch: pd.DataFrame, parameter: str
         out.append({parameter: value, "up": a, "down": b,
                     "fold_below": float(below[-1]) if len(below) else None,
                     "fold_above": float(above[0]) if len(above) else None,
-                    "stable_orbits": int(sum(st for _, st in there))})
+                    "stable_orbits": int(sum(st == "stable" for _, st in there))})
     return out
