@@ -178,3 +178,29 @@ def test_a_study_cut_short_reports_the_orbits_on_disk(tiny_study, tmp_path):
     assert f"| interrupted: cut short: the orbits on disk | {orbits} |" in report
     assert "## The stepped study `fake_stepped` beside the branches" in report
     assert "At the same accuracy" not in report                 # no wall time to count
+
+
+def test_a_branch_that_ends_early_starts_anew_beyond_it_and_from_the_end(tmp_path, monkeypatch):
+    """Each segment that ends (here every one, after 0.2 Hz) starts the next 1 % of the range
+    beyond the farthest value it reached; after MAX_SEGMENTS, one branch from the range's end
+    back towards them.  The tracing itself is stood in for (continuation.continue_branch)."""
+    from workbench.model import continuation
+    from workbench.model.continuation import Branch
+    calls = []
+
+    def ends_early(shooter, lo, hi, on_orbit=None, **_):
+        calls.append((lo, hi))
+        step = 0.2 if hi > lo else -0.2
+        return Branch("freq_hz", orbits=[(lo, None), (lo + step, None)], status="step floor",
+                      message="stood in")
+    monkeypatch.setattr(continuation, "continue_branch", ends_early)
+    study = load(tmp_path, TINY.replace("to = 20.4", "to = 30.0"))
+    summary = B.trace(study, study.points[0], tmp_path / "b", lambda *a: None)
+    step = B.RESTART * (30.0 - 19.6)
+    starts = [lo for lo, _ in calls]
+    assert len(calls) == B.MAX_SEGMENTS + 1
+    assert np.allclose(np.diff(starts[:-1]), 0.2 + step)
+    assert calls[-1] == (30.0, pytest.approx(starts[-2] + 0.2))
+    assert [s["folder"] for s in summary["segments"]][:2] == [".", f"from-{starts[1]:.4g}"]
+    assert summary["segments"][-1]["folder"] == "from-end"
+    assert summary["status"] == f"step floor ({B.MAX_SEGMENTS + 1} segments)"

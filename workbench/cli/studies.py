@@ -58,7 +58,7 @@ def _branches(study, args) -> int:
     ends = {k: s["status"] for k, s in summaries.items()}
     print(json_text({"study": study.name, "branches": ends, "results": str(out),
                      "report": str(out / "report.md")}))
-    return EXIT_OK if all(v == "done" for v in ends.values()) else EXIT_POINTS_FAILED
+    return EXIT_OK if all(v.startswith("done") for v in ends.values()) else EXIT_POINTS_FAILED
 
 
 def _check_scheduler(address: str) -> None:

@@ -25,7 +25,8 @@ every orbit, the figure and ``report.md`` at its end; ``summary.json`` marks it 
 that a study run again resumes with the branches not yet finished, each from its start).
 A branch that ends before the range's end is started anew a little beyond the farthest value
 it reached (RESTART; ``<label>/from-<value>/``: a new segment, found by shooting, which the
-report says is not continued from the last), and a doubled branch (at the first MAX_DOUBLED
+report says is not continued from the last; where MAX_SEGMENTS do not reach the end, a
+branch from the end back towards them, ``<label>/from-end/``), and a doubled branch (at the first MAX_DOUBLED
 period doublings where the orbit loses its stability) goes to ``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
 holds every orbit of every branch, ``report.md`` the study's account.
 
@@ -227,10 +228,20 @@ def _trace(study, point, folder: Path, write) -> dict:
             break
         values = [v for v, _ in branch.orbits] or [start]
         start = (max(values) if direction > 0 else min(values)) + step
+    reached = start - step
+    if segments[-1]["status"] != "done" and (c.end - reached) * direction > 0:
+        # the segments did not reach the end: the branch from the end back towards them
+        sub = folder / "from-end"
+        shooter = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
+                          c.monodromy)
+        branch = continue_branch(shooter, c.end, reached,
+                                 on_orbit=lambda b: write(b, sub, point.params))
+        segments.append({"folder": "from-end", "start": c.end, **_account(branch)})
+        traced.append((branch, shooter))
     last = segments[-1]
     summary = {"label": folder.name, "definition": definition(study, point),
-               "status": last["status"] if len(segments) == 1 or last["status"] == "done"
-               else f"{last['status']} (segment {len(segments)})",
+               "status": last["status"] if len(segments) == 1 else
+               f"{last['status']} ({len(segments)} segments)",
                "message": last["message"], "segments": segments, "doubled": []}
     if c.period_doubling:
         doublings = [(parent, parent_shooter, i) for parent, parent_shooter in traced
