@@ -62,7 +62,7 @@ $(RESULTS)/paper/report.md: $(STAMP) studies/paper.py $(SOURCES) $(RESULTS)/peri
 
 # The branches of periodic orbits over the stepped study's frequencies, beside its points: not
 # part of `make study`.
-branches: $(RESULTS)/branches/report.md  ## periodic orbits over 10-55 Hz at both gaps against the stepped sweeps (about N minutes)
+branches: $(RESULTS)/branches/report.md  ## periodic orbits over 10-55 Hz at both gaps against the stepped sweeps (over an hour on 2 cores)
 
 $(RESULTS)/branches/report.md: $(RESULTS)/stepped/report.md
 

@@ -172,7 +172,9 @@ def test_a_study_cut_short_reports_the_orbits_on_disk(tiny_study, tmp_path):
     shutil.copytree(root / "res", res)
     (res / "tiny_branch" / "gap_mm-1.016" / "summary.json").unlink()
     (root / "tiny.toml").write_text(TINY)
+    (res / "tiny_branch" / "branches.parquet").unlink()
     assert cli.main(["report", str(root / "tiny.toml"), "--results", str(res)]) == 0
+    assert (res / "tiny_branch" / "branches.parquet").is_file()
     report = (res / "tiny_branch" / "report.md").read_text()
     orbits = len(pd.read_parquet(res / "tiny_branch" / "gap_mm-1.016" / "branch.parquet"))
     assert f"| interrupted: cut short: the orbits on disk | {orbits} |" in report

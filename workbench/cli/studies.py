@@ -89,8 +89,11 @@ def _cmd_report(args) -> int:
     if study.continuation is not None:
         from ..present.branch import write_study_report
         from ..study.branches import collect
+        from ..study.store import write_atomic
         out = Path(args.results).resolve() / study.name
-        print(write_study_report(study, out, collect(study, out), Path(args.results).resolve()))
+        table = collect(study, out)
+        write_atomic(table, out / "branches.parquet")        # the table the report links
+        print(write_study_report(study, out, table, Path(args.results).resolve()))
         return EXIT_OK
     if not (Path(args.results) / study.name / "points.parquet").is_file():
         raise ParameterError(f"report {args.study}: no results in {Path(args.results) / study.name}"
