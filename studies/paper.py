@@ -291,7 +291,8 @@ def main(argv=None) -> None:
 def doubling_lines(folder: Path) -> list[str]:
     """The 10 Hz line against the period-1 orbit continued in force at 20 Hz (the period
     doubling study's results in ``folder``), beside the §6 observation."""
-    f = period_doubling_finding(folder)
+    from workbench.study.definition import load
+    f = period_doubling_finding(load(Path(__file__).parent / "period_doubling.toml"), folder)
     head = ["## The 10 Hz line and the period-1 orbit (§6, Fig. 7-8)", ""]
     if f is None:
         return head + [f"The period doubling study has not run (no results in {folder}: "

@@ -77,9 +77,14 @@ def test_the_period_doubling_finding_is_read_from_the_study_and_set_beside_the_l
                             "stability": "stable", "stable": True, "max_multiplier": 0.9,
                             "bifurcation": "", "strain1_h0.5": [1e-5, 3e-5],
                             "strain1_h1": 1e-4, "tip_h0.5_cm": [0.01, 0.02]})
-    pd.concat([main, doubled]).to_parquet(folder / "branches.parquet")
+    main.drop(columns="branch").to_parquet(folder / "branch" / "branch.parquet")
+    (folder / "branch" / "doubled-85").mkdir()
+    doubled.drop(columns="branch").to_parquet(folder / "branch" / "doubled-85" / "branch.parquet")
     text = "\n".join(paper.doubling_lines(folder))
     assert "period doubling between 90 and 85 N" in text and "|μ| 1.200 at 85 N" in text
     assert f"time constant of {-0.05 / math.log(0.9995):.0f} s" in text
     assert "2 orbits over 80-85 N, 2 stable" in text and "up to 0.3 of its 20 Hz line" in text
-    assert "the tip's up to 0.2 mm" in text
+    assert "the tip's up to 0.2 mm" in text and "status done" in text
+    (folder / "branch" / "summary.json").unlink()                 # the study cut short
+    text = "\n".join(paper.doubling_lines(folder))
+    assert "status interrupted" in text and "period doubling between 90 and 85 N" in text

@@ -262,25 +262,27 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
     return lines
 
 
-def period_doubling_finding(folder: Path) -> dict | None:
-    """Where the period-1 orbit of a continuation study's first branch (``folder`` its
+def period_doubling_finding(study, folder: Path) -> dict | None:
+    """Where the period-1 orbit of a continuation ``study``'s first branch (``folder`` its
     results, :mod:`workbench.study.branches`) loses stability by a period doubling: the
     parameter, its range, the first orbit's largest multiplier and the time constant it sets
     (s), the last stable orbit's value before the doubling and the first unstable one's with
     its multiplier, and the doubled branch's orbits, status and largest lines at f / 2 (tip,
-    cm; strain1) against the drive's; ``doubling`` None where the branch has none.  None where
-    the study has not run."""
+    cm; strain1) against the drive's; ``doubling`` None where the branch has none.  A study
+    cut short is read from the orbits on disk (status "interrupted").  None where the study
+    has not run."""
     folder = Path(folder)
-    summaries = sorted(folder.glob("*/summary.json"))
-    if not summaries or not (folder / "branches.parquet").is_file():
+    point, parameter = study.points[0], study.continuation.parameter
+    table = B.collect(study, folder)
+    f = folder / B.label(point) / "summary.json"
+    summary = json.loads(f.read_text()) if f.is_file() else B.cut_short(point, table,
+                                                                         parameter)
+    if summary is None:
         return None
-    summary = json.loads(summaries[0].read_text())
-    table = pd.read_parquet(folder / "branches.parquet")
-    main = table[table.branch == summary["label"]].reset_index(drop=True)
-    parameter = summary["definition"]["continuation"]["parameter"]
+    main = table[table.branch == B.label(point)].reset_index(drop=True)
     first = main.iloc[0]
-    period = 1.0 / float(summary["definition"]["excitation"]["freq_hz"]) \
-        if parameter == "force_n" else 1.0 / float(first[parameter])
+    period = 1.0 / float(point.excitation["freq_hz"]) if parameter == "force_n" \
+        else 1.0 / float(first[parameter])
     out = {"parameter": parameter, "unit": B.PARAMETERS[parameter],
            "start": float(first[parameter]), "end": float(main[parameter].iloc[-1]),
            "status": summary["status"], "message": summary["message"],
@@ -300,7 +302,7 @@ def period_doubling_finding(folder: Path) -> dict | None:
             "multiplier": float(main.max_multiplier.iloc[i]), "doubled": None}
     if doubled:
         d = doubled[0]
-        rows = table[table.branch == f"{summary['label']}/{d['folder']}"]
+        rows = table[table.branch == f"{B.label(point)}/{d['folder']}"]
         info["doubled"] = {"status": d["status"], "message": d["message"],
                            "orbits": len(rows)}
         if len(rows):
