@@ -310,14 +310,16 @@ def doubling_lines(folder: Path) -> list[str]:
     d = f["doubling"]
     if d is None:
         lines += ["", f"It loses stability by no period doubling between {f['start']:g} and "
-                  f"{f['end']:.4g} {unit}: the model's steady state there has no 10 Hz line.",
-                  ""]
+                  f"{f['end']:.4g} {unit}: where it is stable there, the period-1 orbit has no "
+                  "10 Hz line.", ""]
         return lines
     lines += ["", f"**It loses stability by a period doubling between "
               f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** (a multiplier "
-              f"crosses -1: |μ| {d['multiplier']:.3f} at {d['first_unstable']:.4g} {unit}); "
-              f"above {d['last_stable']:.4g} {unit}, the paper's 200 N included, the model's "
-              "steady state has no 10 Hz line."]
+              f"crosses -1: |μ| {d['multiplier']:.3f} at {d['first_unstable']:.4g} {unit}; "
+              "orbits between, if any, of stability undetermined); above "
+              f"{d['last_stable']:.4g} {unit}, the paper's 200 N included, the period-1 orbit, "
+              "which has no 10 Hz line, is stable (a coexisting response is not excluded: "
+              "continuation follows one branch)."]
     dd = d["doubled"]
     if dd and dd.get("orbits"):
         lines += ["", f"The branch of period 2 born there ({dd['orbits']} orbits over "
