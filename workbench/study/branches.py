@@ -19,16 +19,18 @@
     gap_mm = [0.508, 1.016]
 
 Each branch (:func:`workbench.model.continuation.continue_branch`) is written to
-``results/<name>/<label>/`` as ``workbench continue`` writes it
-(:mod:`workbench.present.branch`, which also writes the study's report) (``branch.parquet`` after
-every orbit, the figure and ``report.md`` at its end; ``summary.json`` marks it finished, so
-that a study run again resumes with the branches not yet finished, each from its start).
-A branch that ends before the range's end is started anew a little beyond the farthest value
-it reached (RESTART; ``<label>/from-<value>/``: a new segment, found by shooting, which the
-report says is not continued from the last; where MAX_SEGMENTS do not reach the end, a
-branch from the end back towards them, ``<label>/from-end/``), and a doubled branch (at the first MAX_DOUBLED
-period doublings where the orbit loses its stability) goes to ``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet``
-holds every orbit of every branch, ``report.md`` the study's account.
+``results/<name>/<label>/`` as ``workbench continue`` writes it (:mod:`workbench.present.branch`,
+which also writes the study's report): ``branch.parquet`` after every orbit, the figure and
+``report.md`` at its end.  ``summary.json`` marks it finished, so that a study run again
+traces only the branches not finished with the same definition (each from its start).
+
+A branch that ends before the range's end starts anew RESTART of the range beyond the
+farthest value it reached (``<label>/from-<value>/``: a new segment, found by shooting there,
+not continued from the last); where MAX_SEGMENTS do not reach the end, one branch is traced
+from the end back towards them (``<label>/from-end/``).  The doubled branches of the first
+MAX_DOUBLED period doublings where the orbit loses its stability go to
+``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet`` holds every orbit of every
+branch, ``report.md`` the study's account.
 
 With ``compare``, each stepped point of that study (``results/<compare>/points.parquet``)
 whose other axes match a branch's is set beside the branch at its frequency: the tip's line
