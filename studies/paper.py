@@ -309,14 +309,19 @@ def doubling_lines(folder: Path) -> list[str]:
            if f["time_constant_s"] else "") + "."]
     d = f["doubling"]
     if d is None:
-        lines += ["", f"It loses stability by no period doubling between {f['start']:g} and "
-                  f"{f['end']:.4g} {unit}: where it is stable there, the period-1 orbit has no "
-                  "10 Hz line.", ""]
+        lines += ["", f"It loses stability nowhere between {f['start']:g} and {f['end']:.4g} "
+                  f"{unit}: where it is stable there, the period-1 orbit has no 10 Hz line.", ""]
         return lines
-    lines += ["", f"**It loses stability by a period doubling between "
-              f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** (a multiplier "
-              f"crosses -1: |μ| {d['multiplier']:.3f} at {d['first_unstable']:.4g} {unit}; "
-              "orbits between, if any, of stability undetermined); above "
+    line = ("" if d["line_hz"] is None else
+            f": a new line near {d['line_hz']:.3g} Hz" + (" (the 10 Hz line)"
+                                                        if d["kind"] == "period doubling"
+                                                        else ""))
+    lines += ["", f"**It loses stability by a {d['kind']} between "
+              f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** (its largest "
+              f"multiplier leaves the unit circle: |μ| {d['multiplier']:.3f} at "
+              f"{d['first_unstable']:.4g} {unit}"
+              + ("" if d["angle"] is None else f", at an angle of {d['angle']:.3f} rad")
+              + f"{line}; orbits between, if any, of stability undetermined); above "
               f"{d['last_stable']:.4g} {unit}, the paper's 200 N included, the period-1 orbit, "
               "which has no 10 Hz line, is stable (a coexisting response is not excluded: "
               "continuation follows one branch)."]

@@ -85,6 +85,16 @@ def test_the_period_doubling_finding_is_read_from_the_study_and_set_beside_the_l
     assert f"time constant of {-0.05 / math.log(0.9995):.0f} s" in text
     assert "2 orbits over 80-85 N, 2 stable" in text and "up to 0.3 of its 20 Hz line" in text
     assert "the tip's up to 0.2 mm" in text and "status done" in text
+    assert "a new line near 10 Hz (the 10 Hz line)" in text
     (folder / "branch" / "summary.json").unlink()                 # the study cut short
     text = "\n".join(paper.doubling_lines(folder))
     assert "status interrupted" in text and "period doubling between 90 and 85 N" in text
+    # lost instead by a complex pair near the negative axis (angle 2.9 rad): a line near
+    # 20 * 2.9 / (2 pi) = 9.23 Hz, and no doubled branch
+    main["bifurcation"] = ["", "", "", "neimark-sacker", ""]
+    main["max_multiplier_angle"] = 2.9
+    main.drop(columns="branch").to_parquet(folder / "branch" / "branch.parquet")
+    text = "\n".join(paper.doubling_lines(folder))
+    assert "by a neimark-sacker between 90 and 85 N" in text
+    assert "at an angle of 2.900 rad: a new line near 9.23 Hz;" in text
+    assert "branch of period 2" not in text

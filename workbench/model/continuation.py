@@ -359,7 +359,8 @@ def continue_doubled(shooter: Shooter, branch: Branch, index: int, lo: float, hi
 
 def branch_rows(branch: Branch) -> list[dict]:
     """One row per orbit (CGS like the points table): the parameter, the orbit's responses,
-    contact shares, events per period, the largest multiplier's modulus, how the monodromy
+    contact shares, events per period, the largest multiplier's modulus and angle (rad; +-pi
+    for a real negative one, as at a period doubling), how the monodromy
     was taken, ``stable`` and the ``bifurcation`` between it and the one before."""
     kinds = dict(branch.bifurcations)
     rows = []
@@ -372,6 +373,8 @@ def branch_rows(branch: Branch) -> list[dict]:
                **{f"{k.replace('-', '_')}_per_period": v
                   for k, v in orbit.events_per_period.items()},
                "max_multiplier": float(np.abs(deciding).max(initial=0.0)),
+               "max_multiplier_angle": (float(np.angle(deciding[np.argmax(np.abs(deciding))]))
+                                        if len(deciding) else float("nan")),
                "multiplier_error": orbit.multiplier_error,
                "monodromy": orbit.monodromy_method,
                "stable": orbit.stable is True,

@@ -264,11 +264,13 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
 
 def period_doubling_finding(study, folder: Path) -> dict | None:
     """Where the period-1 orbit of a continuation ``study``'s first branch (``folder`` its
-    results, :mod:`workbench.study.branches`) loses stability by a period doubling: the
-    parameter, its range, the first orbit's largest multiplier and the time constant it sets
-    (s), the last stable orbit's value before the doubling and the first unstable one's with
-    its multiplier, and the doubled branch's orbits, status and largest lines at f / 2 (tip,
-    cm; strain1) against the drive's; ``doubling`` None where the branch has none.  A study
+    results, :mod:`workbench.study.branches`) loses stability, and how: the parameter, its
+    range, the first orbit's largest multiplier and the time constant it sets (s); at the
+    first bifurcation into instability, its kind, the last stable orbit's value before it and
+    the first unstable one's with its largest multiplier's modulus and angle (rad) and the
+    line that angle gives (Hz: f / 2 for a period doubling), and for a period doubling the
+    doubled branch's orbits, status and largest lines at f / 2 (tip, cm; strain1) against the
+    drive's; ``doubling`` None where the branch has none.  A study
     cut short is read from the orbits on disk (status "interrupted").  None where the study
     has not run."""
     folder = Path(folder)
@@ -291,15 +293,22 @@ def period_doubling_finding(study, folder: Path) -> dict | None:
            "time_constant_s": (-period / np.log(first.max_multiplier)
                                if 0 < first.max_multiplier < 1 else None),
            "doubling": None}
-    at = main.index[main.bifurcation == "period doubling"]
+    # the first bifurcation into instability (a fold, period doubling or Neimark-Sacker)
+    at = main.index[main.bifurcation.isin(["fold", "period doubling", "neimark-sacker"])
+                    & (main.stability == "unstable")]
     if not len(at):
         return out
     i = int(at[0])
-    before = main.iloc[:i][main.stability.iloc[:i] != "undetermined"]
-    doubled = [d for d in summary["doubled"]]
-    info = {"last_stable": float(before[parameter].iloc[-1]) if len(before) else None,
-            "first_unstable": float(main[parameter].iloc[i]),
-            "multiplier": float(main.max_multiplier.iloc[i]), "doubled": None}
+    kind = main.bifurcation.iloc[i]
+    before = main.iloc[:i][main.stability.iloc[:i] == "stable"]
+    angle = (abs(float(main.max_multiplier_angle.iloc[i])) if "max_multiplier_angle" in main
+             else np.pi if kind == "period doubling" else None)
+    doubled = [d for d in summary["doubled"]] if kind == "period doubling" else []
+    info = {"kind": kind, "last_stable": float(before[parameter].iloc[-1]) if len(before)
+            else None, "first_unstable": float(main[parameter].iloc[i]),
+            "multiplier": float(main.max_multiplier.iloc[i]), "angle": angle,
+            "line_hz": None if angle is None else float(point.excitation["freq_hz"])
+            * angle / (2 * np.pi) if parameter == "force_n" else None, "doubled": None}
     if doubled:
         d = doubled[0]
         rows = table[table.branch == f"{B.label(point)}/{d['folder']}"]
