@@ -465,6 +465,35 @@ class Shooter:
             step = step / 2.0
         return manifold.project(manifold.move(x, step))
 
+    def _checked(self, manifold, x, regime, ex, record, scale, J, method):
+        """(J, method, the multipliers' error estimate) at an orbit found (module docstring):
+        J against the monodromy at CHECK_FACTOR times its tolerance (or a CHECK_FACTOR-th);
+        a variational J that neither settles is set beside the finite differences, which
+        replace it where the two disagree."""
+        coarse, how = self.monodromy(manifold, x, regime, ex, record, scale, CHECK_FACTOR)
+        error = multiplier_error(J, coarse)
+        if method != "variational" or error <= FINER_ABOVE:
+            return J, method, error
+        finer, how_finer = self.monodromy(manifold, x, regime, ex, record, scale,
+                                          1.0 / CHECK_FACTOR)
+        if how_finer == "variational":
+            error = multiplier_error(J, finer)
+        if error <= FINER_ABOVE:
+            return J, method, error
+        # not settled by its own tolerance: finite differences, checked by their own step,
+        # decide; where they agree, the larger of the two differences
+        fd = self.fd_monodromy(manifold, x, regime, ex, scale)
+        fd_check = coarse if how != "variational" else self.fd_monodromy(
+            manifold, x, regime, ex, scale, FD_REL * CHECK_FACTOR)
+        fd_error = multiplier_error(fd, fd_check)
+        agreement = multiplier_error(J, fd)
+        if agreement <= max(fd_error, FINER_ABOVE):
+            return J, method, max(agreement, fd_error)
+        self.fallback = ("finite differences: the variational equations' multipliers moved "
+                         f"by {fd_error:.1e} with their tolerance and differ from these by "
+                         f"{agreement:.1e}")
+        return fd, "finite-difference", fd_error
+
     def orbit(self, x, regime, ex, record, J, history, iterations, status, message,
               t_wall, method: str = "variational") -> "Orbit":
         """The :class:`Orbit` at a solution (or the last iterate) with its multipliers and the
@@ -482,29 +511,11 @@ class Shooter:
         stable = None
         if status == "ok":
             scale = error_scales(self.P, record.states)
-            coarse, how = self.monodromy(manifold, x, regime, ex, record, scale, CHECK_FACTOR)
-            error = multiplier_error(J, coarse)
-            if method == "variational" and error > FINER_ABOVE:
-                finer, how_finer = self.monodromy(manifold, x, regime, ex, record, scale,
-                                                  1.0 / CHECK_FACTOR)
-                if how_finer == "variational":
-                    error = multiplier_error(J, finer)
-                if error > FINER_ABOVE:
-                    # not settled by its own tolerance: finite differences, checked by their
-                    # own step, decide; where they agree, the larger of the two differences
-                    fd = self.fd_monodromy(manifold, x, regime, ex, scale)
-                    fd_check = coarse if how != "variational" else self.fd_monodromy(
-                        manifold, x, regime, ex, scale, FD_REL * CHECK_FACTOR)
-                    fd_error = multiplier_error(fd, fd_check)
-                    agreement = multiplier_error(J, fd)
-                    if agreement <= max(fd_error, FINER_ABOVE):
-                        error = max(agreement, fd_error)
-                    else:
-                        J, method, error = fd, "finite-difference", fd_error
-                        self.fallback = ("finite differences: the variational equations' "
-                                         f"multipliers moved by {error:.1e} with their "
-                                         f"tolerance and differ from these by {agreement:.1e}")
-                        multipliers, neutral = _floquet(J, manifold, x, scale)
+            J_checked, method, error = self._checked(manifold, x, regime, ex, record, scale, J,
+                                                     method)
+            if J_checked is not J:
+                J = J_checked
+                multipliers, neutral = _floquet(J, manifold, x, scale)
             others = np.abs(np.delete(multipliers, [] if neutral is None else [neutral]))
             largest = others.max(initial=0.0)
             if largest < 1.0 - max(error, STABLE_MARGIN):

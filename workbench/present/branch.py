@@ -303,7 +303,7 @@ def period_doubling_finding(study, folder: Path) -> dict | None:
     before = main.iloc[:i][main.stability.iloc[:i] == "stable"]
     angle = (abs(float(main.max_multiplier_angle.iloc[i])) if "max_multiplier_angle" in main
              else np.pi if kind == "period doubling" else None)
-    doubled = [d for d in summary["doubled"]] if kind == "period doubling" else []
+    doubled = list(summary["doubled"]) if kind == "period doubling" else []
     info = {"kind": kind, "last_stable": float(before[parameter].iloc[-1]) if len(before)
             else None, "first_unstable": float(main[parameter].iloc[i]),
             "multiplier": float(main.max_multiplier.iloc[i]), "angle": angle,

@@ -217,10 +217,14 @@ def _trace(study, point, folder: Path, write) -> dict:
     direction = 1.0 if c.end > c.start else -1.0
     step = RESTART * abs(c.end - c.start) * direction
     segments, traced, start = [], [], c.start
+
+    def shooter_of_point():
+        return Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
+                       c.monodromy)
+
     while len(segments) < MAX_SEGMENTS and (start - c.end) * direction < 0:
         sub = folder if not segments else folder / f"from-{start:.4g}"
-        shooter = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
-                          c.monodromy)
+        shooter = shooter_of_point()
         branch = continue_branch(shooter, start, c.end,
                                  on_orbit=lambda b, sub=sub: write(b, sub, point.params))
         segments.append({"folder": str(sub.relative_to(folder)), "start": start,
@@ -234,8 +238,7 @@ def _trace(study, point, folder: Path, write) -> dict:
     if segments[-1]["status"] != "done" and (c.end - reached) * direction > 0:
         # the segments did not reach the end: the branch from the end back towards them
         sub = folder / "from-end"
-        shooter = Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
-                          c.monodromy)
+        shooter = shooter_of_point()
         branch = continue_branch(shooter, c.end, reached,
                                  on_orbit=lambda b: write(b, sub, point.params))
         segments.append({"folder": "from-end", "start": c.end, **_account(branch)})
