@@ -314,14 +314,16 @@ def doubling_lines(folder: Path) -> list[str]:
         return lines
     line = ("" if d["line_hz"] is None else
             f": a new line near {d['line_hz']:.3g} Hz" + (" (the 10 Hz line)"
-                                                        if d["kind"] == "period doubling"
-                                                        else ""))
-    lines += ["", f"**It loses stability by a {d['kind']} between "
-              f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** (its largest "
-              f"multiplier leaves the unit circle: |μ| {d['multiplier']:.3f} at "
-              f"{d['first_unstable']:.4g} {unit}"
-              + ("" if d["angle"] is None else f", at an angle of {d['angle']:.3f} rad")
-              + f"{line}; orbits between, if any, of stability undetermined); above "
+                                                        if d["crossing"] == "-1" else ""))
+    how = (f"a nonsmooth bifurcation (its events per period change, {d['events_changed']}, "
+           f"and a multiplier jumps out of the unit circle at {d['crossing']})"
+           if d["kind"] == "nonsmooth" else f"a {d['kind']}")
+    lines += ["", f"**It loses stability by {how} between "
+              f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** ("
+              + ("" if d["angle"] is None else f"the multiplier that left the unit circle "
+                 f"lies at an angle of {d['angle']:.3f} rad{line}; ")
+              + f"the largest |μ| at {d['first_unstable']:.4g} {unit} is {d['multiplier']:.3f}; "
+              "orbits between, if any, of stability undetermined); above "
               f"{d['last_stable']:.4g} {unit}, the paper's 200 N included, the period-1 orbit, "
               "which has no 10 Hz line, is stable (a coexisting response is not excluded: "
               "continuation follows one branch)."]

@@ -9,8 +9,8 @@ import pytest
 
 from workbench import cli
 from workbench.model import drives
-from workbench.model.continuation import (Branch, _bifurcation, _tangent, branch_rows,
-                                          continue_branch)
+from workbench.model.continuation import (Branch, _bifurcation, _tangent, _went_back,
+                                          branch_rows, continue_branch, doublings)
 from workbench.model.orbit import Orbit, Shooter, periodic_orbit
 from workbench.model.params import Parameters
 from workbench.present.branch import write_branch
@@ -54,10 +54,16 @@ def test_each_orbit_of_the_branch_is_the_orbit_found_alone(stuck_branch):
     assert np.allclose(np.abs(alone.deciding()), np.abs(orbit.deciding()), atol=1e-5)
 
 
-def _orbit(multipliers, grazing=False, error=1e-6) -> Orbit:
+def _orbit(multipliers, grazing=False, error=1e-6, events=None) -> Orbit:
     mu = np.asarray(multipliers, complex)
     return Orbit("ok", "", 0.05, 1, np.zeros(18), 13, 0.0, 1, mu, bool(np.abs(mu).max() < 1),
-                 grazing, 1.0, {}, {}, 0.0, 0.0, len(mu), multiplier_error=error)
+                 grazing, 1.0, events or {"impact": 4, "stick-slip": 12}, {}, 0.0, 0.0,
+                 len(mu), multiplier_error=error)
+
+
+def _kind(before, after) -> str:
+    found = _bifurcation(before, after, 1)
+    return found.kind if found else ""
 
 
 @pytest.mark.parametrize("before, after, kind", [
@@ -66,18 +72,52 @@ def _orbit(multipliers, grazing=False, error=1e-6) -> Orbit:
     ([0.6 + 0.7j, 0.6 - 0.7j], [0.7 + 0.8j, 0.7 - 0.8j], "neimark-sacker"),
     ([-1.1, 0.5], [-0.9, 0.5], "period doubling"),
     ([0.9, 0.5], [0.95, 0.5], ""),
+    # another multiplier already outside: the one that crossed is the one nearest the circle
+    ([2.5, -0.9, 0.5], [2.9, -1.1, 0.5], "period doubling"),
+    ([-2.5, 0.6 + 0.7j, 0.6 - 0.7j], [-2.4, 0.7 + 0.8j, 0.7 - 0.8j], "neimark-sacker"),
 ])
 def test_a_multiplier_leaving_the_unit_circle_names_the_bifurcation(before, after, kind):
-    assert _bifurcation(_orbit(before), _orbit(after)) == kind
-    assert _bifurcation(_orbit([0.5]), _orbit([0.5], grazing=True)) == "grazing"
+    assert _kind(_orbit(before), _orbit(after)) == kind
+    assert _kind(_orbit([0.5]), _orbit([0.5], grazing=True)) == "grazing"
+
+
+def test_a_change_of_stability_where_the_events_change_is_nonsmooth():
+    """The same multipliers, but an impact more a period on the far side: the multipliers
+    jump with the events, so the change is named nonsmooth, with where its multiplier left
+    the circle (-1), its angle and the events that changed."""
+    after = _orbit([-1.3, 0.5], events={"impact": 5, "stick-slip": 12})
+    found = _bifurcation(_orbit([-0.9, 0.5]), after, 7)
+    assert (found.index, found.kind, found.crossing) == (7, "nonsmooth", "-1")
+    assert found.angle == pytest.approx(np.pi) and found.events_changed == "impact 4->5"
+    assert found.entry(85.0) == {"at": 85.0, "kind": "nonsmooth", "crossing": "-1",
+                                 "events_changed": "impact 4->5"}
+    smooth = _bifurcation(_orbit([0.6 + 0.7j, 0.6 - 0.7j]), _orbit([0.7 + 0.8j, 0.7 - 0.8j]), 3)
+    assert smooth.crossing == "complex" and smooth.angle == pytest.approx(np.angle(0.7 + 0.8j))
+    assert smooth.events_changed == ""
+    branch = Branch("freq_hz", bifurcations=[found, smooth])
+    assert doublings(branch) == [7]
+
+
+def test_a_step_back_to_the_orbit_before_the_last_is_told_from_a_turning_point():
+    """Orbits at 31.08, 31.41 and then 31.30 Hz: back near the first (a zig-zag, as measured
+    at 1.016 mm where the regime at phase 0 changes) is a step back; on past a turning point
+    (the parameter turns, the state moves on) it is not."""
+    def at(value, x):
+        orbit = _orbit([0.5])
+        orbit.state = np.full(18, x)
+        return value, orbit
+    scale, span = np.ones(18), 45.0
+    first, last = at(31.08, 0.0), at(31.41, 1.0)
+    assert _went_back(at(31.10, 0.05), first, last, scale, span)
+    assert not _went_back(at(31.30, 2.0), first, last, scale, span)
 
 
 def test_a_multiplier_within_its_error_of_the_circle_names_nothing():
     """-0.999 and -1.001 with an error estimate of 0.01 either side: no bifurcation is
     claimed (the count outside the circle is not decided), nor without an estimate."""
-    assert _bifurcation(_orbit([-0.999, 0.5], error=0.01), _orbit([-1.001, 0.5])) == ""
-    assert _bifurcation(_orbit([-0.9, 0.5]), _orbit([-1.001, 0.5], error=0.01)) == ""
-    assert _bifurcation(_orbit([-0.9, 0.5]), _orbit([-1.1, 0.5], error=float("nan"))) == ""
+    assert _kind(_orbit([-0.999, 0.5], error=0.01), _orbit([-1.001, 0.5])) == ""
+    assert _kind(_orbit([-0.9, 0.5]), _orbit([-1.001, 0.5], error=0.01)) == ""
+    assert _kind(_orbit([-0.9, 0.5]), _orbit([-1.1, 0.5], error=float("nan"))) == ""
 
 
 def test_a_branch_is_traced_downwards_too():

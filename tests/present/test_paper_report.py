@@ -81,7 +81,7 @@ def test_the_period_doubling_finding_is_read_from_the_study_and_set_beside_the_l
     (folder / "branch" / "doubled-85").mkdir()
     doubled.drop(columns="branch").to_parquet(folder / "branch" / "doubled-85" / "branch.parquet")
     text = "\n".join(paper.doubling_lines(folder))
-    assert "period doubling between 90 and 85 N" in text and "|μ| 1.200 at 85 N" in text
+    assert "period doubling between 90 and 85 N" in text and "|μ| at 85 N is 1.200" in text
     assert f"time constant of {-0.05 / math.log(0.9995):.0f} s" in text
     assert "2 orbits over 80-85 N, 2 stable" in text and "up to 0.3 of its 20 Hz line" in text
     assert "the tip's up to 0.2 mm" in text and "status done" in text
@@ -92,9 +92,23 @@ def test_the_period_doubling_finding_is_read_from_the_study_and_set_beside_the_l
     # lost instead by a complex pair near the negative axis (angle 2.9 rad): a line near
     # 20 * 2.9 / (2 pi) = 9.23 Hz, and no doubled branch
     main["bifurcation"] = ["", "", "", "neimark-sacker", ""]
-    main["max_multiplier_angle"] = 2.9
+    main["multiplier_crossing"] = ["", "", "", "complex", ""]
+    main["crossing_angle"] = 2.9
+    main["max_multiplier_angle"] = 0.0          # the largest multiplier is another one
     main.drop(columns="branch").to_parquet(folder / "branch" / "branch.parquet")
     text = "\n".join(paper.doubling_lines(folder))
     assert "by a neimark-sacker between 90 and 85 N" in text
     assert "at an angle of 2.900 rad: a new line near 9.23 Hz;" in text
     assert "branch of period 2" not in text
+    # a nonsmooth loss at -1 (the events per period change): named so, with its events, its
+    # line the 10 Hz line, and the doubled branch sought there
+    main["bifurcation"] = ["", "", "", "nonsmooth", ""]
+    main["multiplier_crossing"] = ["", "", "", "-1", ""]
+    main["crossing_angle"] = -math.pi
+    main["events_changed"] = ["", "", "", "separation 2->3", ""]
+    main.drop(columns="branch").to_parquet(folder / "branch" / "branch.parquet")
+    text = "\n".join(paper.doubling_lines(folder))
+    assert ("by a nonsmooth bifurcation (its events per period change, separation 2->3, and "
+            "a multiplier jumps out of the unit circle at -1) between 90 and 85 N") in text
+    assert "a new line near 10 Hz (the 10 Hz line)" in text
+    assert "2 orbits over 80-85 N" in text

@@ -245,7 +245,7 @@ def value_or_range(text: str):
 
 def _cmd_continue(args) -> int:
     from ..model import drives
-    from ..model.continuation import branch_rows, continue_branch, continue_doubled
+    from ..model.continuation import branch_rows, continue_branch, continue_doubled, doublings
     from ..model.orbit import Shooter
     from ..model.packing import JOINT
     from ..present.branch import write_branch
@@ -270,18 +270,16 @@ def _cmd_continue(args) -> int:
     branch = continue_branch(shooter, lo, hi, on_orbit=lambda b: write_branch(b, out, p))
     rows = branch_rows(branch)
     doubled = []
-    for i, kind in (branch.bifurcations if args.period_doubling else []):
-        if kind == "period doubling":
-            sub = out / f"doubled-{rows[i][parameter]:.4g}"
-            d = continue_doubled(shooter, branch, i, lo, hi,
-                                 on_orbit=lambda b, sub=sub: write_branch(b, sub, p))
-            doubled.append({"at": rows[i][parameter], "status": d.status,
-                            "message": d.message, "orbits": len(d.orbits), "out": str(sub)})
+    for i in (doublings(branch) if args.period_doubling else []):
+        sub = out / f"doubled-{rows[i][parameter]:.4g}"
+        d = continue_doubled(shooter, branch, i, lo, hi,
+                             on_orbit=lambda b, sub=sub: write_branch(b, sub, p))
+        doubled.append({"at": rows[i][parameter], "status": d.status,
+                        "message": d.message, "orbits": len(d.orbits), "out": str(sub)})
     summary = {"status": branch.status, "message": branch.message, "parameter": parameter,
                "range": [lo, hi], "orbits": len(rows),
                "stable": int(sum(r["stable"] for r in rows)),
-               "bifurcations": [{"at": rows[i][parameter], "kind": k}
-                                for i, k in branch.bifurcations],
+               "bifurcations": [b.entry(rows[b.index][parameter]) for b in branch.bifurcations],
                "doubled": doubled, "wall_s": branch.wall_s, "out": str(out)}
     print(json_text(summary) if args.json else
           f"{branch.status}: {branch.message}; {len(rows)} orbits, {summary['stable']} stable, "

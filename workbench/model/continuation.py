@@ -26,13 +26,26 @@ may run downwards: from 200 N to 40 N).
 At each orbit its multipliers are computed; between two orbits whose number of multipliers
 outside the unit circle is decided (none within its error estimate of the circle,
 :mod:`workbench.model.orbit`; orbits between them where it is not are skipped) a change in
-that number is a bifurcation, named by the multiplier that crossed: through +1 a fold (a
-saddle-node), through -1 a period doubling, as a complex pair a Neimark-Sacker; an open gap
-whose minimum starts or stops touching zero, a grazing.
+that number is a bifurcation.  The multiplier that crossed is the one outside the circle
+nearest to it, on the side with more outside; it crossed at +1, -1 or as a complex pair.
+Where the two orbits have the same events per period (by kind), the crossing is smooth and
+names the bifurcation: at +1 a fold (a saddle-node), at -1 a period doubling, as a complex
+pair a Neimark-Sacker.  Where their events differ (an impact, a separation or a stick phase
+more or fewer a period), the monodromy, a product of saltation matrices and flows, changes
+with the events, and the multipliers jump rather than cross: the change of stability is
+"nonsmooth" (a discontinuity-induced bifurcation: di Bernardo et al., *Piecewise-smooth
+Dynamical Systems*, 2008, ch. 1), with where its multiplier left and the events that
+changed.  An open gap whose minimum starts or stops touching zero is a grazing.  Where the
+parameter turns (its steps change sign) the branch has a fold, whatever its multipliers do;
+an orbit found nearer the orbit before the last than the last is a step back along the
+branch (a zig-zag between two orbits across a change of the regime at phase 0), not taken:
+the step is halved.
 
 **Branch switching at a period doubling** (Seydel §7.4; Kuznetsov, *Elements of Applied
 Bifurcation Theory*, 3rd ed., §4.5): where a multiplier crosses -1, the orbits of twice the
-period branch off.  :func:`doubled_start` seeks one by shooting the 2K-period map from the
+period branch off; where it jumps past -1 at a nonsmooth change of stability, they may
+(a period-doubling border collision: di Bernardo et al. §3.6), and are sought the same way
+(:func:`doublings`).  :func:`doubled_start` seeks one by shooting the 2K-period map from the
 orbit on either side of the crossing, moved along the eigenvector of its multiplier nearest
 -1 by SWITCH_OFFSETS of its error scales, and takes an orbit only if its K-period map does
 not return it (farther than SAME_ORBIT on the scales: not the K-period orbit again);
@@ -75,6 +88,25 @@ SWITCH_OFFSETS = (0.01, 0.03, 0.1, 0.3)
 #: A 2K-period orbit whose K-period map moves it less than this (largest component on the
 #: error scales) is the K-period orbit.
 SAME_ORBIT = 1e-4
+#: A change of stability between orbits with the same events per period, by where the
+#: multiplier crossed the unit circle.
+SMOOTH = {"+1": "fold", "-1": "period doubling", "complex": "neimark-sacker"}
+
+
+@dataclass(frozen=True)
+class Bifurcation:
+    """A bifurcation between a branch's orbits ``index - 1`` and ``index`` (module docstring)."""
+
+    index: int
+    kind: str                  # fold, period doubling, neimark-sacker, nonsmooth, grazing
+    crossing: str = ""         # where the multiplier crossed the circle: +1, -1, complex
+    angle: float = float("nan")    # that multiplier's angle (rad) on the side it is outside
+    events_changed: str = ""   # the events per period that differ: "impact 4->5; ..."
+
+    def entry(self, at: float) -> dict:
+        """This bifurcation in a JSON summary, ``at`` the parameter of the orbit after it."""
+        return {"at": float(at), "kind": self.kind, "crossing": self.crossing,
+                "events_changed": self.events_changed}
 
 
 @dataclass
@@ -83,7 +115,7 @@ class Branch:
 
     parameter: str
     orbits: list = field(default_factory=list)        # (value, Orbit)
-    bifurcations: list = field(default_factory=list)  # (index of the orbit after it, kind)
+    bifurcations: list = field(default_factory=list)  # Bifurcation
     status: str = "running"
     message: str = ""
     wall_s: float = 0.0
@@ -102,20 +134,31 @@ def outside_count(orbit: Orbit) -> int | None:
     return int((mu > 1.0).sum())
 
 
-def _bifurcation(before: Orbit, after: Orbit) -> str:
-    """The kind of a change of stability between two orbits (module docstring), or '' (also
-    where either's count of multipliers outside the unit circle is not decided)."""
+def _events_changed(before: Orbit, after: Orbit) -> str:
+    """The events per period (by kind) that differ between two orbits: "impact 4->5; ...",
+    or ''."""
+    a, b = before.events_per_period, after.events_per_period
+    return "; ".join(f"{k} {a.get(k, 0):g}->{b.get(k, 0):g}" for k in sorted(set(a) | set(b))
+                     if a.get(k, 0) != b.get(k, 0))
+
+
+def _bifurcation(before: Orbit, after: Orbit, index: int) -> Bifurcation | None:
+    """The bifurcation between two orbits, ``after`` the branch's orbit ``index`` (module
+    docstring), or None: no change of stability, or either's count of multipliers outside
+    the unit circle not decided."""
     if before.grazing != after.grazing:
-        return "grazing"
+        return Bifurcation(index, "grazing")
     n_a, n_b = outside_count(before), outside_count(after)
     if n_a is None or n_b is None or n_a == n_b:
-        return ""
-    a, b = before.deciding(), after.deciding()
-    outside = b if n_b > n_a else a                   # the side with the multiplier out
-    crossed = outside[np.argmax(np.abs(outside))]
-    if abs(crossed.imag) > 1e-6 * abs(crossed):
-        return "neimark-sacker"
-    return "fold" if crossed.real > 0 else "period doubling"
+        return None
+    outside = after.deciding() if n_b > n_a else before.deciding()
+    outside = outside[np.abs(outside) > 1.0]
+    crossed = outside[np.argmin(np.abs(outside))]     # the one outside nearest the circle
+    crossing = ("complex" if abs(crossed.imag) > 1e-6 * abs(crossed) else
+                "+1" if crossed.real > 0 else "-1")
+    changed = _events_changed(before, after)
+    return Bifurcation(index, "nonsmooth" if changed else SMOOTH[crossing], crossing,
+                       float(np.angle(crossed)), changed)
 
 
 def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable | None = None,
@@ -173,13 +216,19 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
                 accepted = _correct(shooter, orbit, value, manifold, d, tangent, ds, pin, True)
             if accepted is None:
                 accepted = _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds)
+            if accepted is not None and len(branch.orbits) > 1 and \
+                    _went_back(accepted, branch.orbits[-2], (value, orbit), scale, span):
+                accepted = None
             if accepted is None:
                 ds /= 2.0
         new_value, new_orbit, iterations = accepted
-        kind = ("grazing" if new_orbit.grazing != orbit.grazing else
-                _bifurcation(determined, new_orbit))
-        if kind:
-            branch.bifurcations.append((len(branch.orbits), kind))
+        found = (Bifurcation(len(branch.orbits), "grazing") if new_orbit.grazing != orbit.grazing
+                 else _bifurcation(determined, new_orbit, len(branch.orbits)))
+        if len(branch.orbits) > 1 and (new_value - value) * (value - branch.orbits[-2][0]) < 0:
+            found = Bifurcation(len(branch.orbits), "fold", *(
+                (found.crossing, found.angle, found.events_changed) if found else ()))
+        if found:
+            branch.bifurcations.append(found)
         if outside_count(new_orbit) is not None:
             determined = new_orbit
         branch.orbits.append((new_value, new_orbit))
@@ -195,6 +244,16 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         value, orbit = new_value, new_orbit
     branch.status, branch.message = "max orbits", f"{MAX_ORBITS} orbits"
     return _done(branch, t0, on_orbit)
+
+
+def _went_back(new, before_last, last, scale, span) -> bool:
+    """Whether the orbit ``new`` (value, Orbit, ...) lies nearer the branch's orbit before
+    the last than the last (full state on the error scales ``scale``, parameter on
+    ``span``): the corrector went back along the branch (a zig-zag between two orbits
+    where the regime at phase 0 changes), not on past a turning point."""
+    def distance(a, b):
+        return np.hypot(np.linalg.norm((a[1].state - b[1].state) / scale), (a[0] - b[0]) / span)
+    return distance(new, before_last) < distance(new, last)
 
 
 def _done(branch: Branch, t0: float, on_orbit=None) -> Branch:
@@ -298,6 +357,12 @@ def _across_phase_zero(shooter, orbit, value, manifold, d, tangent, ds):
     return lam, found, found.newton_iterations
 
 
+def doublings(branch: Branch) -> list[int]:
+    """The indices of the orbits after each change of stability of the branch whose
+    multiplier crossed the unit circle at -1 (a period doubling, or a nonsmooth one)."""
+    return [b.index for b in branch.bifurcations if b.crossing == "-1"]
+
+
 def doubled_start(shooter: Shooter, branch: Branch, index: int):
     """(value, Orbit of 2K periods, side) born at the period doubling between the branch's
     orbits ``index - 1`` and ``index`` (module docstring), side +1 where it was found on the
@@ -361,8 +426,10 @@ def branch_rows(branch: Branch) -> list[dict]:
     """One row per orbit (CGS like the points table): the parameter, the orbit's responses,
     contact shares, events per period, the largest multiplier's modulus and angle (rad; +-pi
     for a real negative one, as at a period doubling), how the monodromy
-    was taken, ``stable`` and the ``bifurcation`` between it and the one before."""
-    kinds = dict(branch.bifurcations)
+    was taken, ``stable``, and the ``bifurcation`` between it and the one before with where
+    its multiplier crossed the circle (``multiplier_crossing``: +1, -1, complex), that
+    multiplier's angle (rad) and the events per period that changed."""
+    marked = {b.index: b for b in branch.bifurcations}
     rows = []
     for i, (value, orbit) in enumerate(branch.orbits):
         deciding = orbit.deciding()
@@ -382,7 +449,11 @@ def branch_rows(branch: Branch) -> list[dict]:
                    orbit.stable],
                "grazing": orbit.grazing,
                "contact_code_at_phase0": int(contact_code(orbit.regime)),
-               "bifurcation": kinds.get(i, ""), "newton_iterations": orbit.newton_iterations,
+               "bifurcation": marked[i].kind if i in marked else "",
+               "multiplier_crossing": marked[i].crossing if i in marked else "",
+               "crossing_angle": marked[i].angle if i in marked else float("nan"),
+               "events_changed": marked[i].events_changed if i in marked else "",
+               "newton_iterations": orbit.newton_iterations,
                "residual": orbit.residual}
         rows.append(row)
     return rows

@@ -13,7 +13,7 @@ import json
 import numpy as np
 import pandas as pd
 
-from ..model.continuation import Branch, branch_rows
+from ..model.continuation import SMOOTH, Branch, branch_rows
 from ..study import branches as B
 from ..study.store import write_atomic, write_text_atomic
 from . import figures as F
@@ -22,7 +22,22 @@ from . import units
 #: The axis label of each continuation parameter.
 PARAMETER_LABELS = {"freq_hz": "drive frequency (Hz)", "force_n": "drive force (N)"}
 #: The marker of each kind of bifurcation.
-MARKERS = {"fold": "s", "period doubling": "D", "neimark-sacker": "^", "grazing": "x"}
+MARKERS = {"fold": "s", "period doubling": "D", "neimark-sacker": "^", "nonsmooth": "*",
+           "grazing": "x"}
+
+
+#: What a nonsmooth change of stability is, for the reports.
+NONSMOOTH_NOTE = ("A change of stability is *nonsmooth* where the orbits on its two sides have "
+                  "different events per period: the monodromy changes with the events, and a "
+                  "multiplier jumps across the unit circle rather than crossing it (a "
+                  "discontinuity-induced bifurcation); the column says where it left or "
+                  "entered the circle.")
+
+
+def bifurcation_words(kind: str, crossing: str = "") -> str:
+    """A bifurcation's kind in a report, with where its multiplier crossed the unit circle
+    when the kind does not say it: "nonsmooth (at -1)"."""
+    return f"{kind} (at {crossing})" if kind == "nonsmooth" and crossing else kind
 
 
 def branch_figure(table: pd.DataFrame, parameter: str, title: str,
@@ -102,10 +117,14 @@ def write_branch(branch: Branch, out: Path, params) -> None:
                           table.monodromy.value_counts().items()) if len(table) else "none")
              + ").", ""]
     if branch.bifurcations:
-        lines += ["| at | kind |", "|---|---|"]
-        lines += [f"| {table[branch.parameter].iloc[i]:.5g} | {kind} |"
-                  for i, kind in branch.bifurcations]
+        lines += ["| at | kind | multiplier crossed at | events per period changed |",
+                  "|---|---|---|---|"]
+        lines += [f"| {table[branch.parameter].iloc[b.index]:.5g} | {b.kind} | "
+                  f"{b.crossing or '—'} | {b.events_changed or '—'} |"
+                  for b in branch.bifurcations]
         lines.append("")
+        if any(b.kind == "nonsmooth" for b in branch.bifurcations):
+            lines += [NONSMOOTH_NOTE, ""]
     lines += ["![branch](branch.png) ([PDF](branch.pdf)); every orbit: "
               "[branch.parquet](branch.parquet) (CGS, as the points table).", ""]
     (out / "report.md").write_text("\n".join(lines) + "\n")
@@ -138,10 +157,14 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
         for seg in s["segments"]:
             name = B.label(p) if seg["folder"] == "." else f"{B.label(p)}/{seg['folder']}"
             rows = table[table.branch == name] if len(table) else table
-            bif = "; ".join(f"{b['kind']} at {b['at']:.5g}" for b in seg["bifurcations"])
+            bif = "; ".join(f"{bifurcation_words(b['kind'], b.get('crossing', ''))} at "
+                            f"{b['at']:.5g}" for b in seg["bifurcations"])
             lines.append(f"| [{name}]({name}/report.md) | {seg['status']}: {seg['message']} "
                          f"| {seg['orbits']} | {int(rows.stable.sum()) if len(rows) else 0} | "
                          f"{bif or 'none'} | {seg['wall_s']:.0f} |".replace("| nan |", "| — |"))
+    if any(b["kind"] == "nonsmooth" for _, s in summaries for seg in s["segments"]
+           for b in seg["bifurcations"]):
+        lines += ["", NONSMOOTH_NOTE.replace("; the column says", "; in brackets,")]
     if any(s.get("interrupted") for _, s in summaries):
         lines += ["", "A branch marked interrupted was cut short before it finished: the "
                   "orbits on disk are reported, its wall time is not known."]
@@ -293,18 +316,22 @@ def period_doubling_finding(study, folder: Path) -> dict | None:
            "time_constant_s": (-period / np.log(first.max_multiplier)
                                if 0 < first.max_multiplier < 1 else None),
            "doubling": None}
-    # the first bifurcation into instability (a fold, period doubling or Neimark-Sacker)
-    at = main.index[main.bifurcation.isin(["fold", "period doubling", "neimark-sacker"])
+    # the first bifurcation into instability (any but a grazing)
+    at = main.index[main.bifurcation.isin([*SMOOTH.values(), "nonsmooth"])
                     & (main.stability == "unstable")]
     if not len(at):
         return out
     i = int(at[0])
     kind = main.bifurcation.iloc[i]
+    crossing = (main.multiplier_crossing.iloc[i] if "multiplier_crossing" in main else
+                {v: k for k, v in SMOOTH.items()}.get(kind, ""))
     before = main.iloc[:i][main.stability.iloc[:i] == "stable"]
-    angle = (abs(float(main.max_multiplier_angle.iloc[i])) if "max_multiplier_angle" in main
-             else np.pi if kind == "period doubling" else None)
-    doubled = list(summary["doubled"]) if kind == "period doubling" else []
-    info = {"kind": kind, "last_stable": float(before[parameter].iloc[-1]) if len(before)
+    angle = (abs(float(main.crossing_angle.iloc[i])) if "crossing_angle" in main
+             else {"-1": np.pi, "+1": 0.0}.get(crossing))
+    doubled = list(summary["doubled"]) if crossing == "-1" else []
+    info = {"kind": kind, "crossing": crossing,
+            "events_changed": main.events_changed.iloc[i] if "events_changed" in main else "",
+            "last_stable": float(before[parameter].iloc[-1]) if len(before)
             else None, "first_unstable": float(main[parameter].iloc[i]),
             "multiplier": float(main.max_multiplier.iloc[i]), "angle": angle,
             "line_hz": None if angle is None else float(point.excitation["freq_hz"])

@@ -207,7 +207,7 @@ def trace(study, point, folder: Path, write, sweep_pid: int | None = None) -> di
 
 
 def _trace(study, point, folder: Path, write) -> dict:
-    from ..model.continuation import continue_branch, continue_doubled
+    from ..model.continuation import continue_branch, continue_doubled, doublings
     from ..model.orbit import Shooter
     c = study.continuation
     folder.mkdir(parents=True, exist_ok=True)
@@ -249,28 +249,31 @@ def _trace(study, point, folder: Path, write) -> dict:
                f"{last['status']} ({len(segments)} segments)",
                "message": last["message"], "segments": segments, "doubled": []}
     if c.period_doubling:
-        doublings = [(parent, parent_shooter, i) for parent, parent_shooter in traced
-                     for i, kind in parent.bifurcations
-                     if kind == "period doubling" and parent.orbits[i][1].stable is not True]
-        for parent, parent_shooter, i in doublings[:MAX_DOUBLED]:
+        at = [(parent, parent_shooter, i) for parent, parent_shooter in traced
+              for i in doublings(parent) if parent.orbits[i][1].stable is not True]
+        for parent, parent_shooter, i in at[:MAX_DOUBLED]:
             sub = folder / f"doubled-{parent.orbits[i][0]:.4g}"
             doubled = continue_doubled(parent_shooter, parent, i, c.start, c.end,
                                        on_orbit=lambda b, sub=sub: write(b, sub, point.params))
             summary["doubled"].append({"folder": sub.name, **_account(doubled)})
         summary["doublings_not_traced"] = [parent.orbits[i][0]
-                                           for parent, _, i in doublings[MAX_DOUBLED:]]
+                                           for parent, _, i in at[MAX_DOUBLED:]]
     summary["orbits"] = sum(x["orbits"] for x in segments)
     summary["wall_s"] = sum(x["wall_s"] for x in [*segments, *summary["doubled"]])
     write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
     return summary
 
 
+def _column(table: pd.DataFrame, name: str):
+    """A column of a branch table, or blanks where the table predates it."""
+    return table[name] if name in table else [""] * len(table)
+
+
 def _account(branch) -> dict:
     """A traced branch's end, orbits, wall time and bifurcations, for the summary."""
     return {"status": branch.status, "message": branch.message, "orbits": len(branch.orbits),
             "wall_s": branch.wall_s,
-            "bifurcations": [{"at": branch.orbits[i][0], "kind": k}
-                             for i, k in branch.bifurcations]}
+            "bifurcations": [b.entry(branch.orbits[b.index][0]) for b in branch.bifurcations]}
 
 
 def collect(study, out: Path) -> pd.DataFrame:
@@ -293,6 +296,7 @@ def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
     """The summary of a branch whose tracing was cut short (no ``summary.json``) from the
     orbits on disk (``table``, :func:`collect`): its segments and doubled branches, status
     "interrupted", no wall times; None where it has no orbit on disk."""
+    from ..model.continuation import Bifurcation
     name = label(point)
     mine = table[(table.branch == name) | table.branch.str.startswith(name + "/")] \
         if len(table) else table
@@ -305,8 +309,10 @@ def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
         entry = {"folder": folder, "status": "interrupted",
                  "message": "cut short: the orbits on disk", "orbits": len(rows),
                  "wall_s": float("nan"),
-                 "bifurcations": [{"at": float(v), "kind": k}
-                                  for v, k in zip(marked[parameter], marked.bifurcation)]}
+                 "bifurcations": [Bifurcation(0, k, c, events_changed=e).entry(v)
+                                  for v, k, c, e in zip(marked[parameter], marked.bifurcation,
+                                                        _column(marked, "multiplier_crossing"),
+                                                        _column(marked, "events_changed"))]}
         (doubled if folder.startswith("doubled-") else segments).append(entry)
     return {"label": name, "status": "interrupted", "message": "cut short",
             "segments": segments, "doubled": doubled, "interrupted": True,
