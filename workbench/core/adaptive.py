@@ -84,6 +84,7 @@ def step_error(tol, model, ex, work, scale, ctl, t):
     for i in range(ly.N_AUG):
         y_hat[i] = y_new[i] - err[i]
     if int(rg[ly.RG_SET]) > 0:
+        rg[ly.RG_CNT + 6] += 1.0
         status = rhs_regime(t, y_hat, model, ex, work, stages[ly.STAGE_KTRY])
         if status != ly.OK:
             return status, worst, arg
@@ -184,6 +185,7 @@ def _step_past(e, theta, t, h, model, ex, work, st):
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
+        rg[ly.RG_CNT + 2] += 1.0
         status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st, stages[ly.STAGE_HI])
         if status != ly.OK:
             return status, x
@@ -255,6 +257,8 @@ def _rejected(status, err, arg, h, h_floor, order, ctl):
     """Count a rejected step of h (s) and return the step to try next (s): a quarter after
     a failure, else the controller's decrease, at least h_floor."""
     ctl[ly.CTL_REJECTED] += 1.0
+    if arg == ly.N_STATE + ly.N_EV:
+        ctl[ly.CTL_REJECTED_EVENTS + 0] += 0.0
     ctl[ly.CTL_WORK] += 1.0
     if arg >= ly.N_STATE:
         ctl[ly.CTL_REJECTED_EVENTS] += 1.0
@@ -292,6 +296,7 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
     the event e (-1: none), its fraction theta of the step)."""
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    rg[ly.RG_CNT + 1] += 1.0
     status = pair_step(t, y, h_try, model, ex, work, st, stages[ly.STAGE_NEXT])
     err = np.inf
     arg = -1
@@ -304,6 +309,7 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
     theta = 2.0
     acceptable = err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)
     if status == ly.OK and acceptable and P[ly.P_RK_EXTRA] > 0.0:
+        rg[ly.RG_CNT + 3] += 1.0
         status = prepare_dense(t, y, h_try, model, ex, work)
     if status == ly.OK and acceptable:
         ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
@@ -470,6 +476,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
+            rg[ly.RG_CNT + 8 + (arg - ly.N_STATE if arg >= ly.N_STATE else ly.N_EV + 1)] += 1.0
             h = _rejected(status, err, arg, h_try, h_floor, order, ctl)
             rejected = True
             continue

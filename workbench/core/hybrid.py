@@ -81,6 +81,7 @@ def _trial(theta, t, h, on_dense, model, ex, work):
         dense(theta, h, y, P, stages, y_try)
     else:
         status = rk_step(t, y, theta * h, model, ex, work, y_try)
+    work.rg[ly.RG_CNT + 4] += 1.0
     if status == ly.OK:
         status = rhs_regime(t + theta * h, y_try, model, ex, work, stages[ly.STAGE_KTRY])
     if status == ly.OK:
@@ -587,6 +588,7 @@ def store(stored, t, y, model, ex, work, st, out_t, out_y, out_sig):
     P, tab, kc = model.P, model.tab, model.kc
     rec, mat, vec, stages, cg, rg = work.rec, work.mat, work.vec, work.stages, work.cg, work.rg
     k = stages[ly.STAGE_KTRY]
+    rg[ly.RG_CNT + 5] += 1.0
     status = rhs_regime(t, y, model, ex, work, k)
     if status != ly.OK:
         return status

@@ -238,7 +238,8 @@ RG_LN = 3        # RG_LN + k: normal force lambda_n of point k + 1 (dyn), 0 if o
 RG_LT = RG_LN + N_POINTS   # sticking: tangential force lambda_t (dyn)
 RG_VGRAV = RG_LT + 1       # gravitational energy of the last state (erg)
 RG_ARM = RG_VGRAV + 1      # RG_ARM + k: an open gap's impact fires at g_k < -rg[RG_ARM + k] (cm)
-N_RG = RG_ARM + N_POINTS
+RG_CNT = RG_ARM + N_POINTS
+N_RG = RG_CNT + 40
 
 # Constraint work array cw (N_CW, N_CW_COLS): up to 4 constraint rows A (the
 # normal and tangential rows of two points), their force directions B (A when
@@ -321,7 +322,8 @@ ST_FLOOD_T0 = 20     # start of the window in which events are counted for a flo
 ST_FLOOD_N = 21      # events in that window
 ST_STEPPED_UNTIL = 22    # Moreau-Jean time-stepping runs until this time (s) after a flood
 ST_E_IMPACT_P = 23   # ST_E_IMPACT_P + k: the part of ST_E_IMPACT lost at point k + 1 (erg)
-N_ST = ST_E_IMPACT_P + 4
+ST_CNT = ST_E_IMPACT_P + 4
+N_ST = ST_CNT + 8
 
 # --- the error-controlled integration (workbench.core.adaptive) ----------------
 # Controller record ctl (N_CTL,): its state between calls and its statistics.
