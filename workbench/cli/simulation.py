@@ -387,8 +387,9 @@ def add_parsers(sub) -> None:
                       "FROM:TO to continue over it (either way)")
     cont.add_argument("--out", help="output folder (default results/continue/<parameter>-FROM-TO)")
     cont.add_argument("--period-doubling", action="store_true",
-                      help="at each period doubling also trace the branch of twice the period, "
-                      "into OUT/doubled-<value>/")
+                      help="wherever a multiplier crosses the unit circle at -1 (a period "
+                      "doubling, smooth or nonsmooth) also trace the branch of twice the "
+                      "period, into OUT/doubled-<value>/")
     cont.set_defaults(func=_cmd_continue)
 
     comp = sub.add_parser("compile", help="compile the numba kernels ahead of the first run, "

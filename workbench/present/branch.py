@@ -175,8 +175,8 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
                   "from the one before (the two may lie on different branches)."]
     doubled = [(s["label"], d) for _, s in summaries for d in s["doubled"]]
     if doubled:
-        lines += ["", "Branches of twice the period, switched to at the period doublings "
-                  "(`continue_doubled`):", "", "| branch | status | orbits |", "|---|---|---|"]
+        lines += ["", "Branches of twice the period, switched to where a multiplier left the "
+                  "unit circle at -1 (`continue_doubled`):", "", "| branch | status | orbits |", "|---|---|---|"]
         lines += [f"| [{lab}/{d['folder']}]({lab}/{d['folder']}/report.md) | {d['status']}: "
                   f"{d['message']} | {d['orbits']} |" for lab, d in doubled]
     if c.compare:
@@ -289,9 +289,10 @@ def period_doubling_finding(study, folder: Path) -> dict | None:
     """Where the period-1 orbit of a continuation ``study``'s first branch (``folder`` its
     results, :mod:`workbench.study.branches`) loses stability, and how: the parameter, its
     range, the first orbit's largest multiplier and the time constant it sets (s); at the
-    first bifurcation into instability, its kind, the last stable orbit's value before it and
-    the first unstable one's with its largest multiplier's modulus and angle (rad) and the
-    line that angle gives (Hz: f / 2 for a period doubling), and for a period doubling the
+    first bifurcation into instability, its kind, where its multiplier crossed the unit
+    circle, the events that changed, the last stable orbit's value before it and the first
+    unstable one's with its largest multiplier's modulus, the crossing multiplier's angle
+    (rad) and the line that angle gives (Hz: f / 2 at -1), and for a crossing at -1 the
     doubled branch's orbits, status and largest lines at f / 2 (tip, cm; strain1) against the
     drive's; ``doubling`` None where the branch has none.  A study
     cut short is read from the orbits on disk (status "interrupted").  None where the study

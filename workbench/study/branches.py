@@ -28,7 +28,7 @@ A branch that ends before the range's end starts anew RESTART of the range beyon
 farthest value it reached (``<label>/from-<value>/``: a new segment, found by shooting there,
 not continued from the last); where MAX_SEGMENTS do not reach the end, one branch is traced
 from the end back towards them (``<label>/from-end/``).  The doubled branches of the first
-MAX_DOUBLED period doublings where the orbit loses its stability go to
+MAX_DOUBLED changes of stability at -1 (smooth or nonsmooth) where the orbit loses it go to
 ``<label>/doubled-<value>/``.  ``results/<name>/branches.parquet`` holds every orbit of every
 branch, ``report.md`` the study's account.
 
@@ -67,8 +67,8 @@ HYSTERESIS = 0.1
 #: at most MAX_SEGMENTS times.
 RESTART = 0.01
 MAX_SEGMENTS = 12
-#: The doubled branches traced per branch: at the first MAX_DOUBLED period doublings where the
-#: orbit loses its stability (a multiplier leaving the unit circle through -1).
+#: The doubled branches traced per branch: at the first MAX_DOUBLED changes of stability where
+#: the orbit loses it by a multiplier leaving the unit circle at -1 (smooth or nonsmooth).
 MAX_DOUBLED = 4
 #: A run settles onto a stable orbit, to this fraction of its initial distance, in
 #: log(SETTLE) / log|mu| periods (|mu| its slowest multiplier): the brute force's cost.
