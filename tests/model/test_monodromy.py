@@ -137,3 +137,38 @@ def test_a_perturbation_along_the_leading_floquet_vector_decays_at_its_multiplie
     envelope = np.array([departure[i * n:(i + 10) * n].max() for i in range(0, periods, 10)])
     per_period = np.exp(np.polyfit(np.arange(len(envelope)) * 10.0, np.log(envelope), 1)[0])
     assert abs(per_period - abs(mu[k])) < 1e-4, (per_period, abs(mu[k]))
+
+
+def test_an_unstable_orbit_is_left_at_its_multiplier_along_its_floquet_vector():
+    """83.7 N at 20 Hz (1.016 mm, tip mass, cubic cork): the period-1 orbit is unstable, its
+    largest multiplier real and negative (-1.203, stick-slip and impacts every period).
+    Started 1e-6 of the error scales off it along that multiplier's vector, a run's tip
+    departs from the orbit's by an envelope that grows by |mu| a period (fitted over periods
+    10-40, where the others have decayed: measured 1.2030 against 1.2030) and changes side
+    every period (the multiplier's sign), while the departure stays small (below 1e-3 cm)."""
+    p, f, force = Parameters(), 20.0, 83.7
+    orbit = periodic_orbit(p, drives.sine(force, f))
+    assert orbit.status == "ok" and orbit.stable is False, orbit.message
+    mu, vec = np.linalg.eig(orbit.monodromy)
+    k = int(np.argmax(np.abs(mu)))
+    assert mu[k].real < -1.0 and abs(mu[k].imag) < 1e-9
+    shooter = Shooter(p, drives.sine(force, f))
+    shooter.phase = orbit.phase
+    manifold = shooter.manifold(orbit.state, orbit.regime)
+    _, _, scale, _, _ = shooter.residual(orbit.state, orbit.regime, shooter.ex)
+    v = np.real(vec[:, k])
+    v /= np.max(np.abs(v) / reduced_scales(manifold, scale))
+    periods = 40
+    base = shooter.run(orbit.state, orbit.regime, shooter.ex, periods)
+    run = shooter.run(manifold.project(manifold.move(orbit.state, 1e-6 * v)), orbit.regime,
+                      shooter.ex, periods)
+    assert base.ok and run.ok
+    n = len(base.signal("tip_y")) // periods
+    departure = (run.signal("tip_y") - base.signal("tip_y"))[:periods * n].reshape(periods, n)
+    envelope = np.abs(departure).max(axis=1)
+    assert envelope.max() < 1e-3
+    later = np.arange(10, periods)
+    per_period = np.exp(np.polyfit(later, np.log(envelope[later]), 1)[0])
+    assert abs(per_period - abs(mu[k])) < 2e-3, (per_period, abs(mu[k]))
+    at_phase = departure[later, 0]
+    assert np.all(np.sign(at_phase[1:]) == -np.sign(at_phase[:-1]))
