@@ -32,7 +32,7 @@ from workbench.model.params import Parameters
 from workbench.model.regimes import contact_shares_of
 from workbench.present import figures as F
 from workbench.present import observations as O
-from workbench.present.branch import period_doubling_finding
+from workbench.present.branch import CROSSING_WORDS, period_doubling_finding
 from workbench.present.tables import latex_text
 from workbench.study.leveling import Limits, level
 from workbench.model.validity import accel_peak_g, validity
@@ -316,7 +316,7 @@ def doubling_lines(folder: Path) -> list[str]:
             f": a new line near {d['line_hz']:.3g} Hz" + (" (the 10 Hz line)"
                                                         if d["crossing"] == "-1" else ""))
     how = (f"a nonsmooth bifurcation (its events per period change, {d['events_changed']}, "
-           f"and a multiplier jumps out of the unit circle at {d['crossing']})"
+           f"and a multiplier jumps out of the unit circle {CROSSING_WORDS[d['crossing']]})"
            if d["kind"] == "nonsmooth" else f"a {d['kind']}")
     lines += ["", f"**It loses stability by {how} between "
               f"{d['last_stable']:.4g} and {d['first_unstable']:.4g} {unit}** ("

@@ -34,10 +34,14 @@ NONSMOOTH_NOTE = ("A change of stability is *nonsmooth* where the orbits on its 
                   "entered the circle.")
 
 
+#: Where a multiplier crossed the unit circle, in words.
+CROSSING_WORDS = {"+1": "at +1", "-1": "at -1", "complex": "as a complex pair"}
+
+
 def bifurcation_words(kind: str, crossing: str = "") -> str:
     """A bifurcation's kind in a report, with where its multiplier crossed the unit circle
     when the kind does not say it: "nonsmooth (at -1)"."""
-    return f"{kind} (at {crossing})" if kind == "nonsmooth" and crossing else kind
+    return f"{kind} ({CROSSING_WORDS[crossing]})" if kind == "nonsmooth" and crossing else kind
 
 
 def branch_figure(table: pd.DataFrame, parameter: str, title: str,
