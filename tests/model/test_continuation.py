@@ -9,8 +9,9 @@ import pytest
 
 from workbench import cli
 from workbench.model import drives
-from workbench.model.continuation import (Branch, _bifurcation, _tangent, _went_back,
-                                          branch_rows, continue_branch, doublings)
+from workbench.model.continuation import (Bifurcation, Branch, _bifurcation, _tangent,
+                                          _turning, _went_back, branch_rows, continue_branch,
+                                          doublings)
 from workbench.model.orbit import Orbit, Shooter, periodic_orbit
 from workbench.model.params import Parameters
 from workbench.present.branch import write_branch
@@ -90,7 +91,14 @@ def test_a_change_of_stability_where_the_events_change_is_nonsmooth():
     assert (found.index, found.kind, found.crossing) == (7, "nonsmooth", "-1")
     assert found.angle == pytest.approx(np.pi) and found.events_changed == "impact 4->5"
     assert found.entry(85.0) == {"at": 85.0, "kind": "nonsmooth", "crossing": "-1",
-                                 "events_changed": "impact 4->5"}
+                                 "events_changed": "impact 4->5", "turns": False}
+    # where the parameter also turns there: still named by its crossing at -1, marked as
+    # turning; a turn without a change of stability, or with one at +1, is a fold
+    turning = _turning(found, 7)
+    assert (turning.kind, turning.crossing, turning.turns) == ("nonsmooth", "-1", True)
+    assert _turning(None, 7) == Bifurcation(7, "fold", turns=True)
+    at_one = _bifurcation(_orbit([0.9, 0.5]), _orbit([1.1, 0.5]), 7)
+    assert _turning(at_one, 7).kind == "fold" and _turning(at_one, 7).crossing == "+1"
     smooth = _bifurcation(_orbit([0.6 + 0.7j, 0.6 - 0.7j]), _orbit([0.7 + 0.8j, 0.7 - 0.8j]), 3)
     assert smooth.crossing == "complex" and smooth.angle == pytest.approx(np.angle(0.7 + 0.8j))
     assert smooth.events_changed == ""

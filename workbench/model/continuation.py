@@ -36,7 +36,8 @@ with the events, and the multipliers jump rather than cross: the change of stabi
 "nonsmooth" (a discontinuity-induced bifurcation: di Bernardo et al., *Piecewise-smooth
 Dynamical Systems*, 2008, ch. 1), with where its multiplier left and the events that
 changed.  An open gap whose minimum starts or stops touching zero is a grazing.  Where the
-parameter turns (its steps change sign) the branch has a fold, whatever its multipliers do;
+parameter turns (its steps change sign) the branch has a fold (``turns``; named by the
+change of stability there if one left the circle elsewhere than at +1);
 an orbit found nearer the orbit before the last than the last is a step back along the
 branch (a zig-zag between two orbits across a change of the regime at phase 0), not taken:
 the step is halved.
@@ -102,11 +103,12 @@ class Bifurcation:
     crossing: str = ""         # where the multiplier crossed the circle: +1, -1, complex
     angle: float = float("nan")    # that multiplier's angle (rad) on the side it is outside
     events_changed: str = ""   # the events per period that differ: "impact 4->5; ..."
+    turns: bool = False        # the parameter turns here (its steps change sign)
 
     def entry(self, at: float) -> dict:
         """This bifurcation in a JSON summary, ``at`` the parameter of the orbit after it."""
         return {"at": float(at), "kind": self.kind, "crossing": self.crossing,
-                "events_changed": self.events_changed}
+                "events_changed": self.events_changed, "turns": self.turns}
 
 
 @dataclass
@@ -225,8 +227,7 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         found = (Bifurcation(len(branch.orbits), "grazing") if new_orbit.grazing != orbit.grazing
                  else _bifurcation(determined, new_orbit, len(branch.orbits)))
         if len(branch.orbits) > 1 and (new_value - value) * (value - branch.orbits[-2][0]) < 0:
-            found = Bifurcation(len(branch.orbits), "fold", *(
-                (found.crossing, found.angle, found.events_changed) if found else ()))
+            found = _turning(found, len(branch.orbits))
         if found:
             branch.bifurcations.append(found)
         if outside_count(new_orbit) is not None:
@@ -244,6 +245,16 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         value, orbit = new_value, new_orbit
     branch.status, branch.message = "max orbits", f"{MAX_ORBITS} orbits"
     return _done(branch, t0, on_orbit)
+
+
+def _turning(found: Bifurcation | None, index: int) -> Bifurcation:
+    """The bifurcation where the parameter turns at the branch's orbit ``index``: a fold,
+    unless a change of stability there left the unit circle elsewhere than at +1 (then its
+    own kind, marked as turning)."""
+    if found is None or found.kind == "grazing":
+        return Bifurcation(index, "fold", turns=True)
+    kind = "fold" if found.crossing == "+1" else found.kind
+    return Bifurcation(index, kind, found.crossing, found.angle, found.events_changed, True)
 
 
 def _went_back(new, before_last, last, scale, span) -> bool:
@@ -453,6 +464,7 @@ def branch_rows(branch: Branch) -> list[dict]:
                "multiplier_crossing": marked[i].crossing if i in marked else "",
                "crossing_angle": marked[i].angle if i in marked else float("nan"),
                "events_changed": marked[i].events_changed if i in marked else "",
+               "parameter_turns": bool(i in marked and marked[i].turns),
                "newton_iterations": orbit.newton_iterations,
                "residual": orbit.residual}
         rows.append(row)

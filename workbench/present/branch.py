@@ -38,10 +38,13 @@ NONSMOOTH_NOTE = ("A change of stability is *nonsmooth* where the orbits on its 
 CROSSING_WORDS = {"+1": "at +1", "-1": "at -1", "complex": "as a complex pair"}
 
 
-def bifurcation_words(kind: str, crossing: str = "") -> str:
+def bifurcation_words(kind: str, crossing: str = "", turns: bool = False) -> str:
     """A bifurcation's kind in a report, with where its multiplier crossed the unit circle
-    when the kind does not say it: "nonsmooth (at -1)"."""
-    return f"{kind} ({CROSSING_WORDS[crossing]})" if kind == "nonsmooth" and crossing else kind
+    when the kind does not say it and whether the parameter turns there when the kind is not
+    a fold: "nonsmooth (at -1, the parameter turns)"."""
+    notes = [CROSSING_WORDS[crossing]] if kind == "nonsmooth" and crossing else []
+    notes += ["the parameter turns"] if turns and kind != "fold" else []
+    return f"{kind} ({', '.join(notes)})" if notes else kind
 
 
 def branch_figure(table: pd.DataFrame, parameter: str, title: str,
@@ -123,7 +126,8 @@ def write_branch(branch: Branch, out: Path, params) -> None:
     if branch.bifurcations:
         lines += ["| at | kind | multiplier crossed at | events per period changed |",
                   "|---|---|---|---|"]
-        lines += [f"| {table[branch.parameter].iloc[b.index]:.5g} | {b.kind} | "
+        lines += [f"| {table[branch.parameter].iloc[b.index]:.5g} | "
+                  f"{bifurcation_words(b.kind, turns=b.turns)} | "
                   f"{b.crossing or '—'} | {b.events_changed or '—'} |"
                   for b in branch.bifurcations]
         lines.append("")
@@ -161,8 +165,9 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
         for seg in s["segments"]:
             name = B.label(p) if seg["folder"] == "." else f"{B.label(p)}/{seg['folder']}"
             rows = table[table.branch == name] if len(table) else table
-            bif = "; ".join(f"{bifurcation_words(b['kind'], b.get('crossing', ''))} at "
-                            f"{b['at']:.5g}" for b in seg["bifurcations"])
+            bif = "; ".join(
+                f"{bifurcation_words(b['kind'], b.get('crossing', ''), b.get('turns', False))} "
+                f"at {b['at']:.5g}" for b in seg["bifurcations"])
             lines.append(f"| [{name}]({name}/report.md) | {seg['status']}: {seg['message']} "
                          f"| {seg['orbits']} | {int(rows.stable.sum()) if len(rows) else 0} | "
                          f"{bif or 'none'} | {seg['wall_s']:.0f} |".replace("| nan |", "| — |"))

@@ -264,9 +264,9 @@ def _trace(study, point, folder: Path, write) -> dict:
     return summary
 
 
-def _column(table: pd.DataFrame, name: str):
+def _column(table: pd.DataFrame, name: str, blank=""):
     """A column of a branch table, or blanks where the table predates it."""
-    return table[name] if name in table else [""] * len(table)
+    return table[name] if name in table else [blank] * len(table)
 
 
 def _account(branch) -> dict:
@@ -309,10 +309,12 @@ def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
         entry = {"folder": folder, "status": "interrupted",
                  "message": "cut short: the orbits on disk", "orbits": len(rows),
                  "wall_s": float("nan"),
-                 "bifurcations": [Bifurcation(0, k, c, events_changed=e).entry(v)
-                                  for v, k, c, e in zip(marked[parameter], marked.bifurcation,
-                                                        _column(marked, "multiplier_crossing"),
-                                                        _column(marked, "events_changed"))]}
+                 "bifurcations": [Bifurcation(0, k, c, events_changed=e, turns=bool(t)).entry(v)
+                                  for v, k, c, e, t in zip(
+                                      marked[parameter], marked.bifurcation,
+                                      _column(marked, "multiplier_crossing"),
+                                      _column(marked, "events_changed"),
+                                      _column(marked, "parameter_turns", False))]}
         (doubled if folder.startswith("doubled-") else segments).append(entry)
     return {"label": name, "status": "interrupted", "message": "cut short",
             "segments": segments, "doubled": doubled, "interrupted": True,
@@ -382,7 +384,9 @@ def jumps_and_folds(beside: pd.DataFrame, branch: pd.DataFrame, parameter: str
     (tip lines apart by more than HYSTERESIS of the larger: a jump lies between there and a
     neighbouring step), with the nearest fold of the branch on either side and the stable
     orbits the branch has there: the folds bracket the jump when both exist."""
-    folds = np.sort(branch.loc[branch.bifurcation == "fold", parameter].to_numpy(float))
+    turning = (branch.parameter_turns.to_numpy(bool) if "parameter_turns" in branch else
+               (branch.bifurcation == "fold").to_numpy())
+    folds = np.sort(branch.loc[turning, parameter].to_numpy(float))
     up = beside[beside.direction == "up"].set_index(parameter).stepped_tip_h1_cm
     down = beside[beside.direction == "down"].set_index(parameter).stepped_tip_h1_cm
     out = []
