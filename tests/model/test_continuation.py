@@ -106,6 +106,20 @@ def test_a_change_of_stability_where_the_events_change_is_nonsmooth():
     assert doublings(branch) == [7]
 
 
+def test_a_doubled_branch_ends_where_it_merges_into_the_orbit_of_half_its_period():
+    """The doubled branch at 86.54 N (the period doubling study): 3.4e-3 cm of tip line at
+    10 Hz at 86.44 N, then 2.3e-9 cm at 86.67 N, where it is the period-1 orbit again
+    (strain1's line at 10 Hz there, 5e-6 of its 20 Hz line, is round-off)."""
+    from workbench.model.continuation import _merged
+    doubled, merged = _orbit([0.5]), _orbit([0.5])
+    doubled.responses = {"tip_h1_cm": 0.87, "tip_h0.5_cm": 3.4e-3, "strain1_h1": 1.7e-4,
+                         "strain1_h0.5": 2.9e-9}
+    merged.responses = {"tip_h1_cm": 0.87, "tip_h0.5_cm": 2.3e-9, "strain1_h1": 1.7e-4,
+                        "strain1_h0.5": 8.2e-10}
+    assert _merged(doubled) == "" and _merged(merged).startswith("merged")
+    assert _merged(_orbit([0.5])) == ""                 # no lines: not taken as merged
+
+
 def test_a_step_back_to_the_orbit_before_the_last_is_told_from_a_turning_point():
     """Orbits at 31.08, 31.41 and then 31.30 Hz: back near the first (a zig-zag, as measured
     at 1.016 mm where the regime at phase 0 changes) is a step back; on past a turning point
