@@ -26,12 +26,13 @@ MARKERS = {"fold": "s", "period doubling": "D", "neimark-sacker": "^", "nonsmoot
            "grazing": "x"}
 
 
-#: What a nonsmooth change of stability is, for the reports.
-NONSMOOTH_NOTE = ("A change of stability is *nonsmooth* where the orbits on its two sides have "
-                  "different events per period: the monodromy changes with the events, and a "
-                  "multiplier jumps across the unit circle rather than crossing it (a "
-                  "discontinuity-induced bifurcation); the column says where it left or "
-                  "entered the circle.")
+def nonsmooth_note(where: str) -> str:
+    """What a nonsmooth change of stability is, for the reports; ``where`` says where the
+    report gives the multiplier's crossing ("the column says", "in brackets,")."""
+    return ("A change of stability is *nonsmooth* where the orbits on its two sides have "
+            "different events per period: the monodromy changes with the events, and a "
+            "multiplier jumps across the unit circle rather than crossing it (a "
+            f"discontinuity-induced bifurcation); {where} where it left or entered the circle.")
 
 
 #: Where a multiplier crossed the unit circle, in words.
@@ -132,7 +133,7 @@ def write_branch(branch: Branch, out: Path, params) -> None:
                   for b in branch.bifurcations]
         lines.append("")
         if any(b.kind == "nonsmooth" for b in branch.bifurcations):
-            lines += [NONSMOOTH_NOTE, ""]
+            lines += [nonsmooth_note("the column says"), ""]
     lines += ["![branch](branch.png) ([PDF](branch.pdf)); every orbit: "
               "[branch.parquet](branch.parquet) (CGS, as the points table).", ""]
     (out / "report.md").write_text("\n".join(lines) + "\n")
@@ -173,7 +174,7 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
                          f"{bif or 'none'} | {seg['wall_s']:.0f} |".replace("| nan |", "| — |"))
     if any(b["kind"] == "nonsmooth" for _, s in summaries for seg in s["segments"]
            for b in seg["bifurcations"]):
-        lines += ["", NONSMOOTH_NOTE.replace("; the column says", "; in brackets,")]
+        lines += ["", nonsmooth_note("in brackets,")]
     if any(s.get("interrupted") for _, s in summaries):
         lines += ["", "A branch marked interrupted was cut short before it finished: the "
                   "orbits on disk are reported, its wall time is not known."]
@@ -185,7 +186,8 @@ def write_study_report(study, out: Path, table: pd.DataFrame, results: Path) -> 
     doubled = [(s["label"], d) for _, s in summaries for d in s["doubled"]]
     if doubled:
         lines += ["", "Branches of twice the period, switched to where a multiplier left the "
-                  "unit circle at -1 (`continue_doubled`):", "", "| branch | status | orbits |", "|---|---|---|"]
+                  "unit circle at -1 (`continue_doubled`):", "",
+                  "| branch | status | orbits |", "|---|---|---|"]
         lines += [f"| [{lab}/{d['folder']}]({lab}/{d['folder']}/report.md) | {d['status']}: "
                   f"{d['message']} | {d['orbits']} |" for lab, d in doubled]
     if c.compare:
