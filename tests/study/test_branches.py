@@ -206,3 +206,40 @@ def test_a_branch_that_ends_early_starts_anew_beyond_it_and_from_the_end(tmp_pat
     assert [s["folder"] for s in summary["segments"]][:2] == [".", f"from-{starts[1]:.4g}"]
     assert summary["segments"][-1]["folder"] == "from-end"
     assert summary["status"] == f"step floor ({B.MAX_SEGMENTS + 1} segments)"
+
+
+def test_a_branch_cut_short_resumes_from_its_last_orbit(tmp_path):
+    """A study killed while a branch is traced (here after its 4th orbit) and run again keeps
+    the orbits on disk as an interrupted segment and continues from the last of them, found
+    again from the state its row holds (the same orbit), onwards to the range's end."""
+    from workbench.present.branch import write_branch
+
+    class Killed(BaseException):
+        pass
+
+    def killed_after_four(branch, out, params):
+        write_branch(branch, out, params)
+        if len(branch.orbits) == 4:
+            raise Killed
+
+    study = load(tmp_path, TINY)
+    folder = tmp_path / "b"
+    with pytest.raises(Killed):
+        B.trace(study, study.points[0], folder, killed_after_four)
+    before = pd.read_parquet(folder / "branch.parquet")
+    tracing = json.loads((folder / B.TRACING).read_text())
+    assert len(before) == 4 and [s["status"] for s in tracing["segments"]] == ["running"]
+    summary = B.trace(study, study.points[0], folder, write_branch)
+    segments = summary["segments"]
+    last = before.iloc[-1]
+    assert [s["status"] for s in segments] == ["interrupted", "done"]
+    assert segments[0]["orbits"] == 4 and segments[1]["folder"] == f"resumed-{last.freq_hz:.6g}"
+    after = pd.read_parquet(folder / segments[1]["folder"] / "branch.parquet")
+    assert after.freq_hz.iloc[0] == last.freq_hz
+    state, again = np.asarray(last.state), np.asarray(after.state.iloc[0])
+    assert np.max(np.abs(again - state)) <= 1e-6 * np.max(np.abs(state))
+    assert np.all(np.diff(after.freq_hz) > 0) and after.freq_hz.iloc[-1] > 20.4
+    assert summary["orbits"] == 4 + len(after)
+    again = B.trace(study, study.points[0], folder, write_branch, fresh=True)
+    assert [s["folder"] for s in again["segments"]] == ["."]
+    assert not (folder / segments[1]["folder"] / "branch.parquet").exists()

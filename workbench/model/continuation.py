@@ -121,6 +121,7 @@ class Branch:
     status: str = "running"
     message: str = ""
     wall_s: float = 0.0
+    towards: float = float("nan")    # the value it is traced towards
 
 
 def outside_count(orbit: Orbit) -> int | None:
@@ -165,19 +166,23 @@ def _bifurcation(before: Orbit, after: Orbit, index: int) -> Bifurcation | None:
 
 def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable | None = None,
                     ds: float = DS_FIRST, start: Orbit | None = None,
-                    until: Callable | None = None) -> Branch:
+                    until: Callable | None = None, previous: tuple | None = None,
+                    back_to: float | None = None) -> Branch:
     """Trace the branch of ``shooter``'s orbits from its parameter ``lo`` towards ``hi``
     (module docstring; ``hi`` may be below ``lo``: the branch is traced downwards);
     ``on_orbit(branch)`` is called after each orbit (to write it out).  ``start``: an orbit
     at ``lo`` (default: found from the state after a run).  ``until(orbit)``: a reason to
-    end the branch at that orbit (status "ended"), or ''."""
+    end the branch at that orbit (status "ended"), or ''.  ``previous``: (value, state) of the
+    orbit before ``start`` on the branch (a branch resumed), which orients the first tangent;
+    ``back_to``: the value the branch may not fold back past (default ``lo``)."""
     from .orbit import periodic_orbit
     t0 = time.perf_counter()
     if lo == hi:
         raise ParameterError(f"the range {lo:g}:{hi:g} is empty")
     direction = 1.0 if hi > lo else -1.0
-    branch = Branch(shooter.parameter)
+    branch = Branch(shooter.parameter, towards=hi)
     span = abs(hi - lo)
+    back_to = lo if back_to is None else back_to
     if start is None:
         start = periodic_orbit(shooter.params, shooter.drive_at(lo), shooter.periods,
                                fixed=shooter.fixed)
@@ -203,10 +208,11 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         dR = shooter.d_parameter(manifold, orbit.state, orbit.regime, value)
         pin = _pin(orbit, manifold, d)
         secant = None
-        if len(branch.orbits) > 1:
-            last_value, last = branch.orbits[-2]
-            secant = np.concatenate([(orbit.state - last.state) / scale,
-                                     [(value - last_value) / span]])
+        before = (branch.orbits[-2][0], branch.orbits[-2][1].state) if len(branch.orbits) > 1 \
+            else previous
+        if before is not None:
+            secant = np.concatenate([(orbit.state - before[1]) / scale,
+                                     [(value - before[0]) / span]])
         tangent = _tangent(J, dR, d, manifold, orbit.state, scale, secant, pin, direction)
         accepted = None
         while accepted is None:
@@ -244,9 +250,9 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
         if (new_value - hi) * direction > 0:
             branch.status, branch.message = "done", f"reached {hi:g}"
             return _done(branch, t0, on_orbit)
-        if (new_value - lo) * direction < -1e-9 * span:
+        if (new_value - back_to) * direction < -1e-9 * span:
             branch.status, branch.message = "folded back", (
-                f"the branch turned back past its start {lo:g} (at {new_value:.6g})")
+                f"the branch turned back past its start {back_to:g} (at {new_value:.6g})")
             return _done(branch, t0, on_orbit)
         value, orbit = new_value, new_orbit
     branch.status, branch.message = "max orbits", f"{MAX_ORBITS} orbits"
@@ -386,7 +392,8 @@ def doubled_start(shooter: Shooter, branch: Branch, index: int):
     far orbit's side, -1 on the near one's; None where no such orbit is found."""
     from .orbit import periodic_orbit
     for side, (value, orbit) in ((1, branch.orbits[index]), (-1, branch.orbits[index - 1])):
-        if orbit.monodromy is None or not len(orbit.multipliers):
+        if orbit.status not in ("ok", "grazing") or orbit.monodromy is None \
+                or not len(orbit.multipliers):
             continue
         mu, vectors = np.linalg.eig(orbit.monodromy)
         k = int(np.argmin(np.abs(mu + 1.0)))
@@ -456,13 +463,49 @@ def _merged(orbit: Orbit) -> str:
     return ""
 
 
+def found_again(shooter: Shooter, row) -> tuple[float, Orbit]:
+    """(value, Orbit) of a row of :func:`branch_rows` (``shooter``'s parameter, ``state``,
+    ``regime`` and ``phase``): Newton's method from the stored state, which starts on the
+    orbit (its multipliers and monodromy computed anew)."""
+    from .orbit import periodic_orbit
+    value = float(row[shooter.parameter])
+    orbit = periodic_orbit(shooter.params, shooter.drive_at(value), shooter.periods,
+                           guess=(np.asarray(row["state"], float), int(row["regime"])),
+                           fixed=shooter.fixed, phases=(float(row["phase"]),),
+                           monodromy=shooter.method)
+    return value, orbit
+
+
+def continue_from(shooter: Shooter, rows, lo: float, hi: float,
+                  on_orbit: Callable | None = None, doubled: bool = False) -> Branch:
+    """A branch cut short, continued towards ``hi`` from the last of its orbits stored as
+    ``rows`` of :func:`branch_rows` (a DataFrame), found again (:func:`found_again`), in the
+    direction from the one before it; ``lo``: where the branch started (it may not fold
+    back past it).  A ``doubled`` branch ends where it merges, as :func:`continue_doubled`'s
+    do.  Status "no start" where the orbit is not found again."""
+    t0 = time.perf_counter()
+    value, orbit = found_again(shooter, rows.iloc[-1])
+    previous = None
+    if len(rows) > 1:
+        before = rows.iloc[-2]
+        previous = (float(before[shooter.parameter]), np.asarray(before["state"], float))
+    if orbit.status not in ("ok", "grazing"):
+        return _done(Branch(shooter.parameter, status="no start", message=(
+            f"the orbit on disk at {value:.6g} was not found again: {orbit.message}")),
+            t0, on_orbit)
+    return continue_branch(shooter, value, hi, on_orbit, start=orbit,
+                           until=_merged if doubled else None, previous=previous, back_to=lo)
+
+
 def branch_rows(branch: Branch) -> list[dict]:
     """One row per orbit (CGS like the points table): the parameter, the orbit's responses,
     contact shares, events per period, the largest multiplier's modulus and angle (rad; +-pi
     for a real negative one, as at a period doubling), how the monodromy
     was taken, ``stable``, and the ``bifurcation`` between it and the one before with where
     its multiplier crossed the circle (``multiplier_crossing``: +1, -1, complex), that
-    multiplier's angle (rad) and the events per period that changed."""
+    multiplier's angle (rad) and the events per period that changed; the section's drive
+    ``phase`` (fraction of a period), the ``regime`` there and the orbit's ``state`` (q, q') at
+    it (CGS, rad), from which :func:`found_again` finds it again."""
     marked = {b.index: b for b in branch.bifurcations}
     rows = []
     for i, (value, orbit) in enumerate(branch.orbits):
@@ -489,6 +532,8 @@ def branch_rows(branch: Branch) -> list[dict]:
                "events_changed": marked[i].events_changed if i in marked else "",
                "parameter_turns": bool(i in marked and marked[i].turns),
                "newton_iterations": orbit.newton_iterations,
-               "residual": orbit.residual}
+               "residual": orbit.residual,
+               "phase": orbit.phase, "regime": int(orbit.regime),
+               "state": [float(x) for x in orbit.state]}
         rows.append(row)
     return rows

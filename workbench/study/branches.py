@@ -22,7 +22,10 @@ Each branch (:func:`workbench.model.continuation.continue_branch`) is written to
 ``results/<name>/<label>/`` as ``workbench continue`` writes it (:mod:`workbench.present.branch`,
 which also writes the study's report): ``branch.parquet`` after every orbit, the figure and
 ``report.md`` at its end.  ``summary.json`` marks it finished, so that a study run again
-traces only the branches not finished with the same definition (each from its start).
+traces only the branches not finished with the same definition.  ``tracing.json`` records
+each segment and doubled branch as it goes (TRACING): a study cut short and run again keeps
+what is on disk and resumes each branch where it was, continuing the one that was running
+from its last orbit (found again from the state its row holds).
 
 A branch that ends before the range's end starts anew RESTART of the range beyond the
 farthest value it reached (``<label>/from-<value>/``: a new segment, found by shooting there,
@@ -44,6 +47,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -164,7 +168,7 @@ def run_branches(study, write, results: str | Path = "results", jobs: int = 2,
                       f"trace on {min(jobs, len(todo))} worker(s)", file=sys.stderr)
             with logged_run(out, {"branches_run": len(todo), "jobs": jobs}):
                 Parallel(n_jobs=min(jobs, len(todo)))(
-                    delayed(trace)(study, p, out / label(p), write, os.getpid())
+                    delayed(trace)(study, p, out / label(p), write, os.getpid(), fresh)
                     for p in todo)
         table = collect(study, out)
         write_atomic(table, out / "branches.parquet")
@@ -189,15 +193,16 @@ def finished(study, point, out: Path) -> bool:
         return False
 
 
-def trace(study, point, folder: Path, write, sweep_pid: int | None = None) -> dict:
+def trace(study, point, folder: Path, write, sweep_pid: int | None = None,
+          fresh: bool = False) -> dict:
     """One branch (and its doubled branches): written to ``folder``; its summary (status
     "failed" with the error where tracing raised: the other branches go on).  ``sweep_pid``:
     the study's process; a worker stops itself once that is gone (a killed study leaves no
-    worker tracing)."""
+    worker tracing).  ``fresh``: traced anew from its start, not resumed."""
     if sweep_pid is not None and sweep_pid != os.getpid():
         watch_sweep(sweep_pid)
     try:
-        return _trace(study, point, folder, write)
+        return _trace(study, point, folder, write, fresh)
     except Exception as exc:                           # noqa: BLE001 - kept in the summary
         summary = {"label": folder.name, "definition": definition(study, point),
                    "status": "failed", "message": f"{type(exc).__name__}: {exc}",
@@ -206,62 +211,159 @@ def trace(study, point, folder: Path, write, sweep_pid: int | None = None) -> di
         return summary
 
 
-def _trace(study, point, folder: Path, write) -> dict:
-    from ..model.continuation import continue_branch, continue_doubled, doublings
+#: A branch's folder records its tracing here: the definition, and each segment and doubled
+#: branch as it starts (status "running") and as it ends (its account).  A study cut short
+#: resumes from it: a branch still running is kept as "interrupted" and continued from its
+#: last orbit on disk (in a folder ``resumed-<value>``).
+TRACING = "tracing.json"
+
+
+class _Record:
+    """``folder/TRACING``, read back where its definition is the branch's (unless ``fresh``),
+    else begun anew (and the folder's orbits of another definition, or of none, removed)."""
+
+    def __init__(self, folder: Path, definition: dict, fresh: bool = False):
+        self.path = folder / TRACING
+        try:
+            log = json.loads(self.path.read_text())
+        except (OSError, ValueError):
+            log = {}
+        if fresh or log.get("definition") != definition:
+            for old in folder.glob("**/branch.parquet"):
+                old.unlink()
+            log = {"definition": definition, "segments": [], "doubled": []}
+        self.log = log
+
+    def save(self):
+        write_text_atomic(json.dumps(self.log, indent=1), self.path)
+
+
+def _rows(sub: Path) -> pd.DataFrame:
+    """The orbits on disk in a segment's folder (none where it has no ``branch.parquet``)."""
+    try:
+        return pd.read_parquet(sub / "branch.parquet")
+    except (OSError, ValueError):
+        return pd.DataFrame()
+
+
+def _next_segment(segments: list, c: Continuation, folder: Path):
+    """(folder, from, to) of the segment to trace after ``segments`` (module docstring), or
+    None: the first from the range's start; after one that ends early, the next RESTART of
+    the range beyond the farthest value it reached, MAX_SEGMENTS at most; then one from the
+    range's end back towards them."""
+    if not segments:
+        return folder, c.start, c.end
+    last = segments[-1]
+    if last["status"] == "done" or any(e["folder"] == "from-end" for e in segments):
+        return None
+    direction = 1.0 if c.end > c.start else -1.0
+    reached = last["start"] if last.get("range") is None else \
+        last["range"][1 if direction > 0 else 0]
+    start = reached + RESTART * abs(c.end - c.start) * direction
+    if len(segments) < MAX_SEGMENTS and (start - c.end) * direction < 0:
+        return folder / f"from-{start:.4g}", start, c.end
+    if (c.end - reached) * direction > 0:
+        return folder / "from-end", c.end, reached
+    return None
+
+
+def _trace(study, point, folder: Path, write, fresh: bool = False) -> dict:
+    from ..model.continuation import continue_branch, continue_doubled, continue_from
     from ..model.orbit import Shooter
     c = study.continuation
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "summary.json").unlink(missing_ok=True)
-    for old in folder.glob("**/branch.parquet"):         # an earlier definition's, or cut short
-        old.unlink()
-    direction = 1.0 if c.end > c.start else -1.0
-    step = RESTART * abs(c.end - c.start) * direction
-    segments, traced, start = [], [], c.start
+    record = _Record(folder, definition(study, point), fresh)
+    segments, doubled = record.log["segments"], record.log["doubled"]
 
-    def shooter_of_point():
-        return Shooter(point.params, point.excitation_array(), c.periods, (), c.parameter,
+    def shooter(periods=c.periods):
+        return Shooter(point.params, point.excitation_array(), periods, (), c.parameter,
                        c.monodromy)
 
-    while len(segments) < MAX_SEGMENTS and (start - c.end) * direction < 0:
-        sub = folder if not segments else folder / f"from-{start:.4g}"
-        shooter = shooter_of_point()
-        branch = continue_branch(shooter, start, c.end,
-                                 on_orbit=lambda b, sub=sub: write(b, sub, point.params))
-        segments.append({"folder": str(sub.relative_to(folder)), "start": start,
-                         **_account(branch)})
-        traced.append((branch, shooter))
-        if branch.status == "done":
-            break
-        values = [v for v, _ in branch.orbits] or [start]
-        start = (max(values) if direction > 0 else min(values)) + step
-    reached = start - step
-    if segments[-1]["status"] != "done" and (c.end - reached) * direction > 0:
-        # the segments did not reach the end: the branch from the end back towards them
-        sub = folder / "from-end"
-        shooter = shooter_of_point()
-        branch = continue_branch(shooter, c.end, reached,
-                                 on_orbit=lambda b: write(b, sub, point.params))
-        segments.append({"folder": "from-end", "start": c.end, **_account(branch)})
-        traced.append((branch, shooter))
+    def traced(entries, sub, start, end, run):
+        """One segment or doubled branch traced into ``sub`` by ``run(on_orbit)``, its entry
+        in ``entries`` recorded as it starts, after each orbit (its wall time and the value
+        it is traced towards) and as it ends."""
+        entry = {"folder": str(sub.relative_to(folder)), "start": start, "end": end,
+                 "status": "running", "wall_s": 0.0}
+        entries.append(entry)
+        record.save()
+        t0 = time.perf_counter()
+
+        def on_orbit(branch):
+            write(branch, sub, point.params)
+            entry["wall_s"] = time.perf_counter() - t0
+            if not np.isnan(branch.towards):
+                entry["end"] = branch.towards
+            record.save()
+        entry.update(_account(run(on_orbit)))
+        record.save()
+
+    def resumed(entries, doubled_branch=False):
+        """The last of ``entries`` cut short while running: kept as interrupted, and
+        continued from its last orbit on disk (traced again from its start where it has
+        fewer than two)."""
+        if not entries or entries[-1]["status"] != "running":
+            return
+        entry = entries[-1]
+        rows = _rows(folder / entry["folder"])
+        if len(rows) < 2 or "state" not in rows or entry["end"] is None:
+            entries.pop()
+            return
+        entry.update(_rows_account(rows, c.parameter))
+        row = rows.iloc[-1]
+        value = float(row[c.parameter])
+        sub = folder / f"resumed-{value:.6g}"
+        traced(entries, sub, value, entry["end"],
+               lambda on: continue_from(shooter(int(row["periods"])), rows, entry["start"],
+                                        entry["end"], on, doubled=doubled_branch))
+
+    resumed(segments)
+    while (nxt := _next_segment(segments, c, folder)) is not None:
+        sub, lo, hi = nxt
+        traced(segments, sub, lo, hi, lambda on, lo=lo, hi=hi: continue_branch(
+            shooter(), lo, hi, on_orbit=on))
     last = segments[-1]
     summary = {"label": folder.name, "definition": definition(study, point),
                "status": last["status"] if len(segments) == 1 else
                f"{last['status']} ({len(segments)} segments)",
-               "message": last["message"], "segments": segments, "doubled": []}
+               "message": last["message"], "segments": segments, "doubled": doubled}
     if c.period_doubling:
-        at = [(parent, parent_shooter, i) for parent, parent_shooter in traced
-              for i in doublings(parent) if parent.orbits[i][1].stable is not True]
-        for parent, parent_shooter, i in at[:MAX_DOUBLED]:
-            sub = folder / f"doubled-{parent.orbits[i][0]:.4g}"
-            doubled = continue_doubled(parent_shooter, parent, i, c.start, c.end,
-                                       on_orbit=lambda b, sub=sub: write(b, sub, point.params))
-            summary["doubled"].append({"folder": sub.name, **_account(doubled)})
-        summary["doublings_not_traced"] = [parent.orbits[i][0]
-                                           for parent, _, i in at[MAX_DOUBLED:]]
+        at = [(entry, i) for entry in segments
+              for i in _doublings(_rows(folder / entry["folder"]))]
+        resumed(doubled, doubled_branch=True)
+        for entry, i in at[:MAX_DOUBLED]:
+            rows = _rows(folder / entry["folder"])
+            sub = folder / f"doubled-{rows[c.parameter].iloc[i]:.4g}"
+            if any(d["folder"] == sub.name for d in doubled):
+                continue
+            traced(doubled, sub, float(rows[c.parameter].iloc[i]), None,
+                   lambda on, rows=rows, i=i: continue_doubled(
+                       *_parent(shooter(), rows, i), c.start, c.end, on_orbit=on))
+        summary["doublings_not_traced"] = [
+            float(_rows(folder / entry["folder"])[c.parameter].iloc[i])
+            for entry, i in at[MAX_DOUBLED:]]
     summary["orbits"] = sum(x["orbits"] for x in segments)
-    summary["wall_s"] = sum(x["wall_s"] for x in [*segments, *summary["doubled"]])
+    summary["wall_s"] = sum(x["wall_s"] for x in [*segments, *doubled])
     write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
     return summary
+
+
+def _doublings(rows: pd.DataFrame) -> list[int]:
+    """The rows of a segment after each change of stability whose multiplier crossed the
+    unit circle at -1, where the orbit is not stable (it loses stability there)."""
+    if "multiplier_crossing" not in rows:
+        return []
+    return [i for i in range(len(rows)) if rows.multiplier_crossing.iloc[i] == "-1"
+            and rows.stability.iloc[i] != "stable"]
+
+
+def _parent(shooter, rows: pd.DataFrame, i: int):
+    """(shooter, branch, 1): the two orbits of ``rows`` about the change of stability before
+    row ``i``, found again from their states, as :func:`continue_doubled` takes them."""
+    from ..model.continuation import Branch, found_again
+    pair = [found_again(shooter, rows.iloc[j]) for j in (i - 1, i)]
+    return shooter, Branch(shooter.parameter, orbits=pair), 1
 
 
 def _column(table: pd.DataFrame, name: str, blank=""):
@@ -270,10 +372,28 @@ def _column(table: pd.DataFrame, name: str, blank=""):
 
 
 def _account(branch) -> dict:
-    """A traced branch's end, orbits, wall time and bifurcations, for the summary."""
+    """A traced branch's end, orbits, the range of values they span, wall time and
+    bifurcations, for the summary."""
+    values = [v for v, _ in branch.orbits]
     return {"status": branch.status, "message": branch.message, "orbits": len(branch.orbits),
-            "wall_s": branch.wall_s,
+            "range": [min(values), max(values)] if values else None, "wall_s": branch.wall_s,
             "bifurcations": [b.entry(branch.orbits[b.index][0]) for b in branch.bifurcations]}
+
+
+def _rows_account(rows: pd.DataFrame, parameter: str) -> dict:
+    """The account of a branch cut short (status "interrupted") from its orbits on disk."""
+    from ..model.continuation import Bifurcation
+    marked = rows[rows.bifurcation != ""]
+    values = rows[parameter]
+    return {"status": "interrupted", "message": "cut short: the orbits on disk",
+            "orbits": len(rows),
+            "range": [float(values.min()), float(values.max())] if len(rows) else None,
+            "bifurcations": [Bifurcation(0, k, c, events_changed=e, turns=bool(t)).entry(v)
+                             for v, k, c, e, t in zip(
+                                 marked[parameter], marked.bifurcation,
+                                 _column(marked, "multiplier_crossing"),
+                                 _column(marked, "events_changed"),
+                                 _column(marked, "parameter_turns", False))]}
 
 
 def collect(study, out: Path) -> pd.DataFrame:
@@ -296,7 +416,6 @@ def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
     """The summary of a branch whose tracing was cut short (no ``summary.json``) from the
     orbits on disk (``table``, :func:`collect`): its segments and doubled branches, status
     "interrupted", no wall times; None where it has no orbit on disk."""
-    from ..model.continuation import Bifurcation
     name = label(point)
     mine = table[(table.branch == name) | table.branch.str.startswith(name + "/")] \
         if len(table) else table
@@ -305,16 +424,7 @@ def cut_short(point, table: pd.DataFrame, parameter: str) -> dict | None:
     segments, doubled = [], []
     for branch, rows in mine.groupby("branch", sort=False):
         folder = "." if branch == name else branch[len(name) + 1:]
-        marked = rows[rows.bifurcation != ""]
-        entry = {"folder": folder, "status": "interrupted",
-                 "message": "cut short: the orbits on disk", "orbits": len(rows),
-                 "wall_s": float("nan"),
-                 "bifurcations": [Bifurcation(0, k, c, events_changed=e, turns=bool(t)).entry(v)
-                                  for v, k, c, e, t in zip(
-                                      marked[parameter], marked.bifurcation,
-                                      _column(marked, "multiplier_crossing"),
-                                      _column(marked, "events_changed"),
-                                      _column(marked, "parameter_turns", False))]}
+        entry = {"folder": folder, **_rows_account(rows, parameter), "wall_s": float("nan")}
         (doubled if folder.startswith("doubled-") else segments).append(entry)
     return {"label": name, "status": "interrupted", "message": "cut short",
             "segments": segments, "doubled": doubled, "interrupted": True,
