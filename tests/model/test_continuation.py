@@ -11,7 +11,7 @@ from workbench import cli
 from workbench.model import drives
 from workbench.model.continuation import (Bifurcation, Branch, _bifurcation, _tangent,
                                           _turning, _went_back, branch_rows, continue_branch,
-                                          doublings)
+                                          continue_from, doublings)
 from workbench.model.orbit import Orbit, Shooter, periodic_orbit
 from workbench.model.params import Parameters
 from workbench.present.branch import write_branch
@@ -164,6 +164,24 @@ def test_an_interrupted_continuation_keeps_every_orbit_found(tmp_path):
         continue_branch(shooter, 20.0, 24.0, on_orbit=write_then_stop)
     assert len(pd.read_parquet(tmp_path / "branch.parquet")) == 3
     assert branch_rows(Branch("freq_hz")) == []
+
+
+def test_a_branch_resumed_from_its_rows_goes_on_the_way_it_was_going(stuck_branch):
+    """continue_from the rows of the stuck branch: from its last orbit found again (the
+    same state) onwards; and from two rows read backwards (a branch heading down when it
+    was cut, though traced towards 22 Hz) downwards, until it folds back past its start."""
+    branch, out = stuck_branch
+    rows = pd.read_parquet(out / "branch.parquet")
+    shooter = Shooter(Parameters(), drives.sine(0.5, 18.0), parameter="freq_hz")
+    onwards = continue_from(shooter, rows.iloc[:3], 18.0, rows.freq_hz.iloc[4])
+    values = [v for v, _ in onwards.orbits]
+    assert values[0] == rows.freq_hz.iloc[2] and np.all(np.diff(values) > 0)
+    assert onwards.status == "done"
+    assert np.allclose(onwards.orbits[0][1].state, rows.state.iloc[2], rtol=1e-6, atol=1e-12)
+    back = continue_from(shooter, rows.iloc[[2, 1]], 18.0, 22.0)
+    values = [v for v, _ in back.orbits]
+    assert values[0] == rows.freq_hz.iloc[1] and np.all(np.diff(values) < 0)
+    assert back.status == "folded back" and values[-1] < 18.0
 
 
 def test_the_continue_command_refuses_what_it_cannot_trace(tmp_path, capsys):
