@@ -184,6 +184,23 @@ def test_a_branch_resumed_from_its_rows_goes_on_the_way_it_was_going(stuck_branc
     assert back.status == "folded back" and values[-1] < 18.0
 
 
+def test_a_branch_that_ends_at_the_step_floor_is_written_with_its_report(stuck_branch, tmp_path,
+                                                                        monkeypatch):
+    """A corrector that never converges (stood in) halves the step to its floor: the branch
+    ends there with its status, and its table, figure and report are written."""
+    from workbench.model import continuation
+    branch, _ = stuck_branch
+    p = Parameters()
+    monkeypatch.setattr(continuation, "_correct", lambda *a, **k: None)
+    monkeypatch.setattr(continuation, "_across_phase_zero", lambda *a, **k: None)
+    shooter = Shooter(p, drives.sine(0.5, 18.0), parameter="freq_hz")
+    ended = continue_branch(shooter, 18.0, 22.0, start=branch.orbits[0][1],
+                            on_orbit=lambda b: write_branch(b, tmp_path, p))
+    assert ended.status == "step floor" and len(ended.orbits) == 1
+    assert "Status: step floor" in (tmp_path / "report.md").read_text()
+    assert (tmp_path / "branch.png").exists()
+
+
 def test_the_continue_command_refuses_what_it_cannot_trace(tmp_path, capsys):
     assert cli.main(["continue", "--freq-hz", "25:25", "--out", str(tmp_path)]) == 2
     assert "a range is FROM:TO, two different finite numbers" in capsys.readouterr().err

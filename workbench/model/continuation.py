@@ -220,7 +220,7 @@ def continue_branch(shooter: Shooter, lo: float, hi: float, on_orbit: Callable |
                 branch.status, branch.message = "step floor", (
                     f"the step fell below {DS_MIN:g} at {value:.6g}: a turning point the "
                     "corrector cannot pass, a grazing or the end of a regime at phase 0")
-                return _done(branch, t0)
+                return _done(branch, t0, on_orbit)
             accepted = _correct(shooter, orbit, value, manifold, d, tangent, ds, pin)
             if accepted is None and shooter.method == "variational":
                 accepted = _correct(shooter, orbit, value, manifold, d, tangent, ds, pin, True)
