@@ -296,7 +296,7 @@ def _trace(study, point, folder: Path, write, fresh: bool = False) -> dict:
             if not np.isnan(branch.towards):
                 entry["end"] = branch.towards
             record.save()
-        entry.update(_account(run(on_orbit)))
+        entry.update(_account(run(on_orbit)), wall_s=time.perf_counter() - t0)
         record.save()
 
     def resumed(entries, doubled_branch=False):
