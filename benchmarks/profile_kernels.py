@@ -37,7 +37,7 @@ GROUPS = {
         ("constrained.add_contact_forces", "constrained.rhs_regime",
          "constrained.stick_margin", "contact.fill_geometry"),
     "the pair's stage sums, estimate and dense output":
-        ("pair.pair_step", "pair.dense", "pair.prepare_dense", "integrate.stage_state"),
+        ("pair.pair_step", "pair.dense", "pair.prepare_dense"),
     "event functions": ("event_functions.event_values",),
     "projection onto the regime's constraints":
         ("constrained.project", "constrained._project_rows", "constrained._project_gaps"),

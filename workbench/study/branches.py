@@ -329,20 +329,18 @@ def _trace(study, point, folder: Path, write, fresh: bool = False) -> dict:
                f"{last['status']} ({len(segments)} segments)",
                "message": last["message"], "segments": segments, "doubled": doubled}
     if c.period_doubling:
-        at = [(entry, i) for entry in segments
-              for i in _doublings(_rows(folder / entry["folder"]))]
+        at = [(rows, i) for rows in (_rows(folder / entry["folder"]) for entry in segments)
+              for i in _doublings(rows)]
         resumed(doubled, doubled_branch=True)
-        for entry, i in at[:MAX_DOUBLED]:
-            rows = _rows(folder / entry["folder"])
-            sub = folder / f"doubled-{rows[c.parameter].iloc[i]:.4g}"
+        for rows, i in at[:MAX_DOUBLED]:
+            value = float(rows[c.parameter].iloc[i])
+            sub = folder / f"doubled-{value:.4g}"
             if any(d["folder"] == sub.name for d in doubled):
                 continue
-            traced(doubled, sub, float(rows[c.parameter].iloc[i]), None,
-                   lambda on, rows=rows, i=i: continue_doubled(
-                       *_parent(shooter(), rows, i), c.start, c.end, on_orbit=on))
-        summary["doublings_not_traced"] = [
-            float(_rows(folder / entry["folder"])[c.parameter].iloc[i])
-            for entry, i in at[MAX_DOUBLED:]]
+            traced(doubled, sub, value, None, lambda on, rows=rows, i=i: continue_doubled(
+                *_parent(shooter(), rows, i), c.start, c.end, on_orbit=on))
+        summary["doublings_not_traced"] = [float(rows[c.parameter].iloc[i])
+                                           for rows, i in at[MAX_DOUBLED:]]
     summary["orbits"] = sum(x["orbits"] for x in segments)
     summary["wall_s"] = sum(x["wall_s"] for x in [*segments, *doubled])
     write_text_atomic(json.dumps(summary, indent=1), folder / "summary.json")
