@@ -243,3 +243,47 @@ def test_a_branch_cut_short_resumes_from_its_last_orbit(tmp_path):
     again = B.trace(study, study.points[0], folder, write_branch, fresh=True)
     assert [s["folder"] for s in again["segments"]] == ["."]
     assert not (folder / segments[1]["folder"] / "branch.parquet").exists()
+
+
+def test_doubled_branches_are_traced_where_the_orbit_loses_stability_at_minus_one(tmp_path,
+                                                                                  monkeypatch):
+    """From the rows on disk: a doubled branch at each change of stability at -1 into an
+    orbit that is not stable (not where the orbit after it is stable), MAX_DOUBLED of them,
+    the rest listed; traced again, the record's finished branches are not traced again.
+    The tracing itself is stood in for."""
+    from workbench.model import continuation
+    from workbench.model.continuation import Branch
+    values = [19.6 + 0.15 * k for k in range(8)]
+    crossing = ["", "-1", "-1", "-1", "-1", "-1", "-1", ""]
+    stability = ["stable", "unstable", "unstable", "stable", "unstable", "unstable", "unstable",
+                 "unstable"]
+    traced, doubled = [], []
+
+    def whole_branch(shooter, lo, hi, on_orbit=None, **_):
+        traced.append(lo)
+        branch = Branch("freq_hz", orbits=[(v, None) for v in values], status="done",
+                        towards=hi)
+        on_orbit(branch)
+        return branch
+
+    def write(branch, sub, params):
+        sub.mkdir(parents=True, exist_ok=True)
+        pd.DataFrame({"freq_hz": values, "multiplier_crossing": crossing,
+                      "stability": stability, "bifurcation": [""] * len(values)}
+                     ).to_parquet(sub / "branch.parquet")
+
+    def stood_in(shooter, parent, index, lo, hi, on_orbit=None):
+        doubled.append(parent)
+        return Branch("freq_hz", status="ended", message="stood in")
+    monkeypatch.setattr(continuation, "continue_branch", whole_branch)
+    monkeypatch.setattr(continuation, "continue_doubled", stood_in)
+    monkeypatch.setattr(B, "_parent", lambda shooter, rows, i: (shooter, rows.freq_hz.iloc[i], 1))
+    study = load(tmp_path, TINY.replace("compare =", "period_doubling = true, compare ="))
+    summary = B.trace(study, study.points[0], tmp_path / "b", write)
+    assert doubled == [values[i] for i in (1, 2, 4, 5)] and B.MAX_DOUBLED == 4
+    assert [d["folder"] for d in summary["doubled"]] == [f"doubled-{values[i]:.4g}"
+                                                         for i in (1, 2, 4, 5)]
+    assert summary["doublings_not_traced"] == [values[6]]
+    (tmp_path / "b" / "summary.json").unlink()                  # cut short after the last
+    again = B.trace(study, study.points[0], tmp_path / "b", write)
+    assert traced == [19.6] and len(doubled) == 4 and again["doubled"] == summary["doubled"]
