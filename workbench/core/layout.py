@@ -85,7 +85,36 @@ P_RK_DEGREE = P_RK_D + MAX_RK_STAGES * MAX_DENSE_DEGREE   # the dense output's d
 P_RK_EXTRA = P_RK_DEGREE + 1      # stages computed for the dense output only (after the s of a step)
 P_RK_E3 = P_RK_EXTRA + 1          # P_RK_E3 + i: a second, lower-order error weight (DOP853's; 0: none)
 P_RK_STEP_FACTOR = P_RK_E3 + MAX_RK_STAGES   # a controlled step is at most this many base steps
-N_PARAMS = P_RK_STEP_FACTOR + 1
+N_RK_END = P_RK_STEP_FACTOR + 1   # the step method's entries end here
+# --- a beam's inertia invariants ---------------------------------------------
+# Weighted sums over a beam's Gauss points, fixed once the parameters are
+# (workbench.core.inertia.fill_invariants); the mass matrix, h and gravity
+# are polynomials in the beam's coordinates with these coefficients.  With
+# m = mu w and r = rho_I w a point's mass and rotary inertia, X its position
+# along its root frame's axis (the root's offset included), xi, N = (N1, N2),
+# S = (S00, S01, S11) and d = (dN1, dN2) its shape-table entries:
+INV_M = 0      # sum m (g)
+INV_X = 1      # sum m X (g cm)
+INV_XX = 2     # sum m X^2 (g cm^2)
+INV_XI = 3     # sum m xi (g)
+INV_XIXI = 4   # sum m xi^2 (g)
+INV_XXI = 5    # sum m X xi (g cm)
+INV_N = 6      # sum m N (2)
+INV_NN = 8     # sum m N N^T: (1,1), (1,2), (2,2) (3)
+INV_XIN = 11   # sum m xi N (2)
+INV_XN = 13    # sum m X N (2)
+INV_S = 15     # sum m S (3)
+INV_XS = 18    # sum m X S (3)
+INV_XIS = 21   # sum m xi S (3)
+INV_NS = 24    # sum m N1 S (3), then sum m N2 S (3)
+INV_SS = 30    # sum m S_a S_b, (a, b) = (00,00), (00,01), (00,11), (01,01), (01,11), (11,11) (6)
+INV_R = 36     # sum r (g cm^2)
+INV_RD = 37    # sum r d (2)
+INV_RDD = 39   # sum r d d^T: (1,1), (1,2), (2,2) (3)
+N_INV = 42
+P_INV_A = N_RK_END               # beam A's invariants (N_INV)
+P_INV_B = P_INV_A + N_INV        # beam B's, its root at the loose body's outer end (N_INV)
+N_PARAMS = P_INV_B + N_INV
 
 # --- shape-function tables ---------------------------------------------------
 # One row per beam point (the Gauss points of a beam, or a sensor position):

@@ -26,6 +26,7 @@ import numpy as np
 from ..core import layout as ly
 from ..core.cork import FORMS as CORK_FORMS
 from ..core.dynamics import fill_stiffness_damping
+from ..core.inertia import fill_invariants
 from ..core.shapes import fill_shape_row
 from .params import ParameterError, Parameters
 from .tableaus import RK4, write_tableau
@@ -91,6 +92,7 @@ def pack(p: Parameters) -> np.ndarray:
     # needs the linear eigenvalues, which need this array: workbench.model.simulate sets it
     P[ly.P_STEPPED_DT] = math.inf
     write_tableau(P, RK4)       # the step method; a run's method may write another
+    fill_invariants(P, shape_table(p))
     return P
 
 

@@ -143,7 +143,7 @@ class Pair(Tableau):
 def write_tableau(P: np.ndarray, tableau: Tableau) -> None:
     """Put ``tableau`` into the parameter array P at layout ``P_RK_*``."""
     m = ly.MAX_RK_STAGES
-    P[ly.P_RK_STAGES:ly.N_PARAMS] = 0.0
+    P[ly.P_RK_STAGES:ly.N_RK_END] = 0.0
     P[ly.P_RK_STAGES] = tableau.stages
     P[ly.P_RK_ORDER] = tableau.order
     for i in range(tableau.stages):
