@@ -281,13 +281,15 @@ def _add_beam(acc, P, base, q, qd, i0, omega):
 
 
 @nb.njit(**JIT_INLINE)
-def _add_frame(acc, f, u, moving, i0, g, M, h, Q):
+def _add_frame(acc, f, u, moving, i0, n_moving, g, M, h, Q):
     """Add the accumulated points of frame record ``f`` to M, h and Q_g.
 
     ``moving`` False is the ground frame (beam A): R = I, J0 = 0, a = 0.
     ``u`` is a scratch record for the frame's rotated Jacobian rows.
-    ``i0`` the first of the three local columns.  Fills the upper triangle
-    of M only.  Returns the frame's gravitational energy (erg).
+    ``i0`` the first of the three local columns; the frame's origin and
+    angle move with the first ``n_moving`` coordinates only (its Jacobian
+    rows J0 and a are zero beyond).  Fills the upper triangle of M only.
+    Returns the frame's gravitational energy (erg).
     """
     m = acc[A_M]
     cx = acc[A_C]
@@ -308,19 +310,17 @@ def _add_frame(acc, f, u, moving, i0, g, M, h, Q):
         gy = -g * (m * co)
         ga = -g * (-cy * si + cx * co)
         # U's rows x and y (R^T J0) once, into the scratch record u
-        for i in range(ly.N_DOF):
+        for i in range(n_moving):
             u[ly.JX + i] = co * f[ly.JX + i] + si * f[ly.JY + i]
             u[ly.JY + i] = -si * f[ly.JX + i] + co * f[ly.JY + i]
-        for i in range(ly.N_DOF):
+        for i in range(n_moving):
             ui0 = u[ly.JX + i]
             ui1 = u[ly.JY + i]
             ui2 = f[ly.AA + i]
-            if ui0 == 0.0 and ui1 == 0.0 and ui2 == 0.0:
-                continue
             vi0 = b00 * ui0 + b01 * ui1 + b02 * ui2
             vi1 = b01 * ui0 + b11 * ui1 + b12 * ui2
             vi2 = b02 * ui0 + b12 * ui1 + b22 * ui2
-            for j in range(i, ly.N_DOF):
+            for j in range(i, n_moving):
                 M[i, j] += vi0 * u[ly.JX + j] + vi1 * u[ly.JY + j] + vi2 * f[ly.AA + j]
             h[i] += ui0 * hx + ui1 * hy + ui2 * ha
             Q[i] += ui0 * gx + ui1 * gy + ui2 * ga
@@ -362,12 +362,12 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
     # beam A: the ground frame
     _reset(acc)
     _add_beam(acc, P, ly.P_INV_A, q, qd, ly.W_A, 0.0)
-    v_grav = _add_frame(acc, rec[ly.REC_JOINT], rec[ly.REC_U], False, ly.W_A, g, M, h, Q)
+    v_grav = _add_frame(acc, rec[ly.REC_JOINT], rec[ly.REC_U], False, ly.W_A, 0, g, M, h, Q)
     # joint body: a rigid point of the joint frame
     fj = rec[ly.REC_JOINT]
     _reset(acc)
     _add_rigid_point(acc, P[ly.P_M3], P[ly.P_I3], P[ly.P_C3], 0.0, fj[ly.RATE])
-    v_grav += _add_frame(acc, fj, rec[ly.REC_U], True, ly.W_A, g, M, h, Q)
+    v_grav += _add_frame(acc, fj, rec[ly.REC_U], True, ly.W_A, ly.U_A + 1, g, M, h, Q)
     # loose body, beam B and the tip mass: the loose-body frame
     fl = rec[ly.REC_LOOSE]
     omega = fl[ly.RATE]
@@ -376,5 +376,5 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
     _add_beam(acc, P, ly.P_INV_B, q, qd, ly.W_B, omega)
     _add_beam_point(acc, P[ly.P_M6], P[ly.P_I6], tab[tip_row(P, ly.R_TIP_B)], q, qd, ly.W_B,
                     P[ly.P_L4], 0.0, 1.0, omega)
-    v_grav += _add_frame(acc, fl, rec[ly.REC_U], True, ly.W_B, g, M, h, Q)
+    v_grav += _add_frame(acc, fl, rec[ly.REC_U], True, ly.W_B, ly.PSI + 1, g, M, h, Q)
     return v_grav
