@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pandas as pd
@@ -194,8 +195,13 @@ def test_a_hammer_run_written_as_uff_gives_the_locked_modes(tmp_path, capsys):
             assert found["zeta"] == pytest.approx(zn, rel=0.02), (fn, zn, found)
     assert [m["zeta_resolved"] for m in res["modes"]] == [False, True, True, True]
     assert res["modes"][0]["zeta"] is None
-    assert res["notes"] == [f"1.97 Hz: the record spans 0.094 of its decay times, fewer than "
-                            f"{MIN_DECAY_TIMES:g}; too short to measure its damping ratio"]
+    # the span's figure comes from the unresolved mode's estimated damping: about 0.09
+    assert len(res["notes"]) == 1
+    note = re.fullmatch(r"1\.97 Hz: the record spans (0\.\d+) of its decay times, fewer than "
+                        f"{MIN_DECAY_TIMES:g}; too short to measure its damping ratio",
+                        res["notes"][0])
+    assert note, res["notes"]
+    assert float(note.group(1)) == pytest.approx(0.094, rel=0.05)
     assert (out / "frf.uff").exists() and not list(tmp_path.glob(".frf.partial-*"))
 
 

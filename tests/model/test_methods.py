@@ -102,7 +102,7 @@ def test_the_tableau_is_written_where_the_kernels_read_it():
     assert list(P[ly.P_RK_B:ly.P_RK_B + 3]) == list(KUTTA3.b)
     np.testing.assert_array_equal(P[ly.P_RK_A:ly.P_RK_E].reshape(m, m)[:3, :3], KUTTA3.matrix())
     assert not P[ly.P_RK_A:ly.P_RK_E].reshape(m, m)[3:].any()
-    assert not P[ly.P_RK_E:].any()                  # no error weights, no dense output
+    assert not P[ly.P_RK_E:ly.N_RK_END].any()        # no error weights, no dense output
     write_tableau(P, DOPRI5)
     assert P[ly.P_RK_DEGREE] == 4 and list(P[ly.P_RK_E:ly.P_RK_E + 7]) == list(DOPRI5.e)
 
