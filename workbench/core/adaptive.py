@@ -39,7 +39,7 @@ from . import layout as ly
 from .constrained import rhs_regime
 from .contact import regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
-from .event_functions import event_values
+from .event_functions import event_values_after_rhs
 from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _stepped, _trial,
                      apply_event, begin, flooding, locate, passed_before, penetration, step_end,
                      store)
@@ -87,7 +87,7 @@ def step_error(tol, model, ex, work, scale, ctl, t):
         status = rhs_regime(t, y_hat, model, ex, work, stages[ly.STAGE_KTRY])
         if status != ly.OK:
             return status, worst, arg
-    event_values(y_hat, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
+    event_values_after_rhs(y_hat, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
     for e in range(ly.N_EV):
         r = abs(ev[ly.EV_END, e] - ev[ly.EV_TRY, e]) / (tol * event_scale(e, P, scale, ctl))
         if r > worst:
@@ -187,7 +187,7 @@ def _step_past(e, theta, t, h, model, ex, work, st):
         status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st, stages[ly.STAGE_HI])
         if status != ly.OK:
             return status, x
-        event_values(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
+        event_values_after_rhs(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
         f = ev[ly.EV_HI, e]
         if f < 0.0:
             hi = x
@@ -297,7 +297,7 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
     arg = -1
     force = 0.0
     if status == ly.OK:
-        event_values(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+        event_values_after_rhs(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
         force = total_normal_force(rg)
         status, err, arg = step_error(tol, model, ex, work, scale, ctl, t + h_try)
     e = -1

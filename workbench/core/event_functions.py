@@ -13,7 +13,7 @@ Every event function goes from + to - when its event happens (layout ``EV_*``):
 """
 import numba as nb
 
-from .config import JIT, LAMBDA_EPS, RATE_EPS
+from .config import JIT, JIT_INLINE, LAMBDA_EPS, RATE_EPS
 from . import layout as ly
 from .constrained import stick_margin, stick_tolerance, tangent_point
 from .contact import fill_geometry, in_set, row_rate
@@ -26,6 +26,21 @@ def event_values(y, P, free, cg, rg, ev, row, rate_row):
     The contact forces in rg must be those of y (rhs_regime just ran).
     """
     fill_geometry(y, P, cg)
+    _values(y, P, free, cg, rg, ev, row, rate_row)
+
+
+@nb.njit(**JIT)
+def event_values_after_rhs(y, P, free, cg, rg, ev, row, rate_row):
+    """:func:`event_values` right after ``rhs_regime`` at y: in contact, its geometry in cg
+    is y's already (``constrained.add_contact_forces`` filled it) and is not computed again."""
+    if int(rg[ly.RG_SET]) == 0:
+        fill_geometry(y, P, cg)
+    _values(y, P, free, cg, rg, ev, row, rate_row)
+
+
+@nb.njit(**JIT_INLINE)
+def _values(y, P, free, cg, rg, ev, row, rate_row):
+    """The event functions at y with its geometry in cg."""
     qd = y[ly.N_DOF:ly.N_STATE]
     set_index = int(rg[ly.RG_SET])
     stick = rg[ly.RG_STICK] != 0.0

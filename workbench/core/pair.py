@@ -25,14 +25,14 @@ import numpy as np
 from .config import JIT, JIT_INLINE
 from . import layout as ly
 from .constrained import project, rhs_regime
-from .event_functions import event_values
+from .event_functions import event_values_after_rhs
 from .integrate import stage_state
 
 
 @nb.njit(**JIT_INLINE)
 def _stage_events_min(yt, P, free, cg, rg, ev):
     """Lower ev[EV_MIN] to the event functions at a stage's state (its rhs_regime just ran)."""
-    event_values(yt, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
+    event_values_after_rhs(yt, P, free, cg, rg, ev, ly.EV_TRY, ly.EV_RATE_TRY)
     for e in range(ly.N_EV):
         ev[ly.EV_MIN, e] = min(ev[ly.EV_MIN, e], ev[ly.EV_TRY, e])
 
