@@ -11,7 +11,8 @@ from workbench import cli
 from workbench.core import layout as ly
 from workbench.model import drives
 from workbench.model.modes import _state_matrix
-from workbench.model.orbit import error_scales, lattice, periodic_orbit
+from workbench.model.orbit import (MAX_STEP, Shooter, error_scales, lattice, periodic_orbit,
+                                   reduced_scales)
 from workbench.model import packing as mdl
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.simulate import simulate
@@ -98,6 +99,25 @@ def test_a_search_that_does_not_converge_says_so_and_reports_no_orbit():
                            newton_tol=1e-30)
     assert orbit.status == "not converged" and orbit.stable is None
     assert np.isfinite(orbit.residual) and orbit.residual > 0
+
+
+def test_a_newton_step_whose_period_map_fails_is_cut_not_fatal():
+    """A Newton step far outside the orbit (a thousand error scales in every reduced
+    coordinate: the loose body metres along its slot) makes the period map's run fail; the
+    damped step is cut and halved, and what it returns is a state whose map runs (at 47 Hz,
+    1.016 mm, 200 N such a step used to end the search with status "failed")."""
+    shooter = Shooter(Parameters(), drives.sine(200.0, 20.0))
+    x, regime = shooter.guess(shooter.ex)
+    manifold = shooter.manifold(x, regime)
+    x = manifold.project(x)
+    _, _, scale, residual, _ = shooter.residual(x, regime, shooter.ex)
+    wild = 1000.0 * reduced_scales(manifold, scale)
+    with pytest.raises(ParameterError):
+        shooter.residual(manifold.project(manifold.move(x, wild)), regime, shooter.ex)
+    moved = shooter._damped(manifold, x, regime, shooter.ex, wild, residual, scale)
+    assert np.max(np.abs(manifold.coordinates(moved - x)) / reduced_scales(manifold, scale)) \
+        <= MAX_STEP * (1 + 1e-9)
+    shooter.residual(moved, regime, shooter.ex)              # runs
 
 
 def test_bad_input_is_refused_in_one_line(capsys):
