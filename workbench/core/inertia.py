@@ -185,12 +185,8 @@ def _add_beam(acc, P, base, q, qd, i0, omega):
     - q_f / 2, ry = N.b; the cubic and quartic sums come from
     Z_j = sum m (S b)_j S and W = sum m (N.b) S.
     """
-    w = q[i0]
-    p = q[i0 + 1]
-    u = q[i0 + 2]
-    wd = qd[i0]
-    pd = qd[i0 + 1]
-    ud = qd[i0 + 2]
+    w, p, u = q[i0], q[i0 + 1], q[i0 + 2]
+    wd, pd, ud = qd[i0], qd[i0 + 1], qd[i0 + 2]
     o2 = omega * omega
     ss = base + ly.INV_SS
     # Z_0 = sum m (S b)_0 S and Z_1 = sum m (S b)_1 S, each (00, 01, 11)
@@ -221,13 +217,9 @@ def _add_beam(acc, P, base, q, qd, i0, omega):
     isb0 = P[i] * w + P[i + 1] * p
     isb1 = P[i + 1] * w + P[i + 2] * p
     isbb = isb0 * w + isb1 * p                                # sum m xi q_f
-    m_xixi = P[base + ly.INV_XIXI]
-    m_xxi = P[base + ly.INV_XXI]
-    m_xi = P[base + ly.INV_XI]
-    n0 = P[base + ly.INV_N]
-    n1 = P[base + ly.INV_N + 1]
-    xin0 = P[base + ly.INV_XIN]
-    xin1 = P[base + ly.INV_XIN + 1]
+    m_xixi, m_xxi, m_xi = P[base + ly.INV_XIXI], P[base + ly.INV_XXI], P[base + ly.INV_XI]
+    n0, n1 = P[base + ly.INV_N], P[base + ly.INV_N + 1]
+    xin0, xin1 = P[base + ly.INV_XIN], P[base + ly.INV_XIN + 1]
     nn = base + ly.INV_NN
     cx = P[base + ly.INV_X] + m_xi * u - 0.5 * (sb0 * w + sb1 * p)    # sum m rx
     cy = n0 * w + n1 * p                                                # sum m ry
