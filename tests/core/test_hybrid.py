@@ -250,7 +250,8 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     assert run.stats["max_penetration_where"] // 10 == 1          # found at an event
     ev = run.events
     deepest = ev.iloc[int(np.argmin(np.abs(ev.t - run.stats["t_max_penetration"])))]
-    assert deepest.kind == "impact" and deepest.t == pytest.approx(run.stats["t_max_penetration"], abs=1e-12)
+    assert deepest.kind == "impact"
+    assert deepest.t == pytest.approx(run.stats["t_max_penetration"], abs=1e-12)
     impulse = sum(deepest[f"impulse_n{k}"] for k in range(1, 5))
     closing_speed = 2.0 * deepest.ke_lost / impulse                # cm/s, an upper bound
     assert 0.0 < run.stats["max_penetration_cm"] < closing_speed * EVENT_TIME_TOL + GAP_EPS

@@ -118,7 +118,7 @@ def _add_beam_point(acc, m, rot, row, q, qd, i0, x_offset, d0, d1, omega):
 
 @nb.njit(**JIT)
 def fill_invariants(P, tab):
-    """Write both beams' inertia invariants (``layout.INV_*``) into P from the Gauss rows of ``tab``.
+    """Write both beams' inertia invariants (``layout.INV_*``) into P from ``tab``'s Gauss rows.
 
     Beam A's points lie at X = x in the ground frame, beam B's at X = L4 + x
     in the loose-body frame; masses mu w (g), rotary inertias rho_I w (g cm^2).

@@ -73,7 +73,7 @@ from .regimes import SETS, contact_code, in_contact, is_stick, set_of
 #: error scales, in the same regime), the run's nearest point to an orbit of K periods (the
 #: close returns of Lathrop & Kostelich, Phys. Rev. A 40, 4028, 1989).  The state at the run's
 #: end instead: at 83.7 N, 20 Hz Newton's method converges from 35 periods and not from 20,
-#: 25, 30, 40 or 60; from the closest return of 40 it does, and at 42 Hz, 200 N too.
+#: 25, 30, 40 or 60; from the closest return of 40 it does, and at 42 Hz, 200 N too (6ba25b2).
 GUESS_PERIODS = 40
 RAMP_PERIODS = 5
 RETURN_FROM = 10
@@ -586,8 +586,8 @@ def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
 
     ``drive``: a sine (``drives.sine(force_n, freq_hz)`` or its settings; the soft start is
     dropped).  ``guess``: (state (18,), regime) at the first phase to start Newton from; by
-    default the closest return of a run from the static equilibrium (``Shooter.guess``).  The section
-    is taken at the drive phases ``phases`` in turn (fractions of a period) until one gives
+    default the closest return of a run from the static equilibrium (``Shooter.guess``).
+    The section is taken at the drive phases ``phases`` in turn (fractions of a period) until one gives
     an orbit.  Returns an :class:`Orbit` whose ``status`` says whether it was found; never
     one it did not find.  ``monodromy``: "variational" or "finite-difference" (module
     docstring).
