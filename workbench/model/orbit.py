@@ -587,8 +587,8 @@ def periodic_orbit(params: Parameters, drive, periods: int = 1, guess=None,
     ``drive``: a sine (``drives.sine(force_n, freq_hz)`` or its settings; the soft start is
     dropped).  ``guess``: (state (18,), regime) at the first phase to start Newton from; by
     default the closest return of a run from the static equilibrium (``Shooter.guess``).
-    The section is taken at the drive phases ``phases`` in turn (fractions of a period) until one gives
-    an orbit.  Returns an :class:`Orbit` whose ``status`` says whether it was found; never
+    The section is taken at the drive phases ``phases`` in turn (fractions of a period)
+    until one gives an orbit.  Returns an :class:`Orbit` whose ``status`` says whether it was found; never
     one it did not find.  ``monodromy``: "variational" or "finite-difference" (module
     docstring).
     """
