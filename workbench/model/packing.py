@@ -59,8 +59,9 @@ def coordinate_index(name: str | int) -> int:
                          f"or 0..{ly.N_DOF - 1}")
 
 
-def pack(p: Parameters) -> np.ndarray:
-    """The flat parameter array P (N_PARAMS,), CGS, in the declared layout."""
+def pack(p: Parameters, tab: np.ndarray | None = None) -> np.ndarray:
+    """The flat parameter array P (N_PARAMS,), CGS, in the declared layout; the beams'
+    inertia invariants from the shape table ``tab`` (default :func:`shape_table` of p)."""
     P = np.zeros(ly.N_PARAMS)
     P[ly.P_L_A], P[ly.P_L_B] = p.l_a, p.l_b
     P[ly.P_MU_A], P[ly.P_MU_B] = p.mu_a, p.mu_b
@@ -92,7 +93,7 @@ def pack(p: Parameters) -> np.ndarray:
     # needs the linear eigenvalues, which need this array: workbench.model.simulate sets it
     P[ly.P_STEPPED_DT] = math.inf
     write_tableau(P, RK4)       # the step method; a run's method may write another
-    fill_invariants(P, shape_table(p))
+    fill_invariants(P, shape_table(p) if tab is None else tab)
     return P
 
 
@@ -142,10 +143,11 @@ def build(p: Parameters, fixed: Iterable[str | int] = ()) -> Model:
 def _packed(p: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """P, the shape table and K and C of ``p``, read-only: a run packs its parameters once
     for the run, its static start and its linear model (joint free and locked)."""
-    P = pack(p)
+    tab = shape_table(p)
+    P = pack(p, tab)
     kc = np.zeros((2, ly.N_DOF, ly.N_DOF))
     fill_stiffness_damping(P, kc)
-    arrays = (P, shape_table(p), kc)
+    arrays = (P, tab, kc)
     for a in arrays:
         a.flags.writeable = False
     return arrays
