@@ -123,9 +123,9 @@ def test_a_run_packs_its_parameters_once(monkeypatch):
     calls = []
     real = packing.pack
 
-    def counting(p):
+    def counting(p, *rest):
         calls.append(p)
-        return real(p)
+        return real(p, *rest)
     monkeypatch.setattr(packing, "pack", counting)
     p = Parameters().replace(gap_mm=0.9137, tip_mass=False)      # packed nowhere else
     simulate(p, sine(20.0, 20.0, ramp_s=0.01), 0.02)
