@@ -11,8 +11,8 @@ from workbench import cli
 from workbench.core import layout as ly
 from workbench.model import drives
 from workbench.model.modes import _state_matrix
-from workbench.model.orbit import (MAX_STEP, Shooter, error_scales, lattice, periodic_orbit,
-                                   reduced_scales)
+from workbench.model.orbit import (MAX_STEP, SETTLE, Shooter, error_scales, lattice,
+                                   periodic_orbit, reduced_scales)
 from workbench.model import packing as mdl
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.simulate import simulate
@@ -41,6 +41,10 @@ def test_the_stuck_joints_orbit_has_the_locked_models_multipliers():
             assert abs(m - near) <= 1e-4 * abs(near), (m, near)
         else:
             assert abs(m - near) <= 2e-4, (m, near)
+    # the slowest linear mode (about 2 Hz, decay rate zeta omega) sets the settling time
+    slowest = lam[np.argmax(lam.real)]
+    assert orbit.settle_s() == pytest.approx(np.log(SETTLE) / slowest.real, rel=1e-3)
+    assert orbit.slowest_hz() == pytest.approx(abs(slowest.imag) / (2 * np.pi), rel=1e-3)
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +87,7 @@ def test_the_orbit_command_prints_the_json_the_issue_names(capsys):
     out = json.loads(capsys.readouterr().out)
     for key in ("status", "period_s", "periods", "residual", "newton_iterations", "multipliers",
                 "stable", "events_per_period", "contact_time_share", "tip_amplitude_cm",
-                "wall_s", "grazing"):
+                "wall_s", "grazing", "settle_s", "slowest_multiplier_hz"):
         assert key in out, key
     assert out["status"] == "ok" and out["period_s"] == pytest.approx(0.05)
     assert all(len(m) == 2 for m in out["multipliers"])

@@ -201,7 +201,7 @@ def human_summary(summary: dict, out=None) -> str:
 
 def _cmd_orbit(args) -> int:
     from ..model import drives
-    from ..model.orbit import periodic_orbit
+    from ..model.orbit import SETTLE, periodic_orbit
     from ..model.packing import JOINT
     p = parameters_of(args)
     orbit = periodic_orbit(p, drives.sine(args.force_n, args.freq_hz), periods=args.periods,
@@ -223,6 +223,9 @@ def _cmd_orbit(args) -> int:
             f"{'contact code':>20}: {found['contact_code']} at phase 0; events per period: "
             + (", ".join(f"{k} {v:g}" for k, v in orbit.events_per_period.items() if v) or "none"),
             f"{'tip amplitude':>20}: {_plain(orbit.tip_amplitude_cm * SI['cm'][1])} mm",
+            *([] if orbit.settle_s() is None else [
+                f"{'settles':>20}: to {SETTLE:g} of a disturbance in {orbit.settle_s():.3g} s "
+                f"(slowest multiplier at {orbit.slowest_hz():.3g} Hz)"]),
             f"{'wall':>20}: {orbit.wall_s:.3g} s"]))
     return EXIT_OK if orbit.status == "ok" else EXIT_NOT_CONVERGED
 

@@ -113,6 +113,16 @@ NEUTRAL_TOL = 5e-3
 GRAZE_REL = 1e-4
 #: Samples a drive period of the orbit's record (the tip's amplitude, the gaps' minimum).
 SAMPLES_PER_PERIOD = 400
+#: A disturbance of a stable orbit falls to SETTLE of itself in log(SETTLE) / log|mu| orbit
+#: periods, |mu| its largest deciding multiplier: how long a run started near it takes to
+#: reach it (``settle_s``), the brute force's cost.
+SETTLE = 1e-3
+
+
+def settle_periods(mu: float) -> float:
+    """Orbit periods for a disturbance along the multiplier of modulus ``mu`` (0 < mu < 1) to
+    fall to SETTLE of itself; nan for any other modulus."""
+    return float(np.log(SETTLE) / np.log(mu)) if 0.0 < mu < 1.0 else float("nan")
 
 
 @dataclass
@@ -156,6 +166,23 @@ class Orbit:
         i = int(np.argmin(np.abs(self.multipliers - self.neutral)))
         return np.delete(self.multipliers, i)
 
+    def settle_s(self) -> float | None:
+        """Time (s) in which a disturbance of this stable orbit falls to SETTLE of itself along
+        its slowest multiplier; None unless the orbit is stable."""
+        mu = self.deciding()
+        if self.stable is not True or not len(mu):
+            return None
+        return settle_periods(float(np.abs(mu).max())) * self.period_s
+
+    def slowest_hz(self) -> float | None:
+        """The slowest multiplier's frequency (Hz): its angle over 2 pi times the orbit's period,
+        in [0, 1 / (2 period_s)] (a mode's frequency is this modulo 1 / period_s); None
+        without multipliers."""
+        mu = self.deciding()
+        if not len(mu):
+            return None
+        return abs(float(np.angle(mu[np.argmax(np.abs(mu))]))) / (2 * np.pi * self.period_s)
+
     def to_dict(self) -> dict:
         """The JSON object of ``workbench orbit --json``."""
         return {"status": self.status, "message": self.message, "period_s": self.period_s,
@@ -163,6 +190,7 @@ class Orbit:
                 "newton_iterations": self.newton_iterations,
                 "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
                 "stable": self.stable, "multiplier_error": self.multiplier_error,
+                "settle_s": self.settle_s(), "slowest_multiplier_hz": self.slowest_hz(),
                 "grazing": self.grazing,
                 "min_open_gap_cm": self.min_open_gap_cm,
                 "events_per_period": self.events_per_period,

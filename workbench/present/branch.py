@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..model.continuation import SMOOTH, Branch, branch_rows
+from ..model.orbit import SETTLE
 from ..study import branches as B
 from ..study.store import write_atomic, write_text_atomic
 from . import figures as F
@@ -286,7 +287,7 @@ def _comparison(study, out, table, results, summaries) -> list[str]:
                   "machine, not side by side.", ""]
         if settle_s:
             lines += [f"At the same accuracy: a run settles onto a stable orbit to "
-                      f"{B.SETTLE:g} of its distance in log({B.SETTLE:g}) / log|μ| periods (|μ| "
+                      f"{SETTLE:g} of its distance in log({SETTLE:g}) / log|μ| periods (|μ| "
                       "the orbit's largest multiplier): at the stepped points with a stable "
                       f"orbit, {np.median(settle_s):.0f} s of simulated time (median; "
                       f"{min(settle_s):.0f}–{max(settle_s):.0f} s), {np.median(settle_wall):.0f} "

@@ -74,9 +74,6 @@ MAX_SEGMENTS = 12
 #: The doubled branches traced per branch: at the first MAX_DOUBLED changes of stability where
 #: the orbit loses it by a multiplier leaving the unit circle at -1 (smooth or nonsmooth).
 MAX_DOUBLED = 4
-#: A run settles onto a stable orbit, to this fraction of its initial distance, in
-#: log(SETTLE) / log|mu| periods (|mu| its slowest multiplier): the brute force's cost.
-SETTLE = 1e-3
 #: [study] keys of a grid's runs, which a continuation study does not take.
 GRID_ONLY = ("duration_s", "window_s", "sweep", "save_series", "check_accuracy", "dt",
              "output_hz", "tol", "method", "initial")
@@ -460,7 +457,8 @@ def stepped_beside(branch: pd.DataFrame, stepped: pd.DataFrame, parameter: str
     """Each stepped point beside the branch (module docstring): its tip line, the nearest
     orbit's there, whether that orbit is stable and its largest multiplier, their difference
     relative to the stepped one, the periods a run takes to settle onto a stable orbit
-    (SETTLE), and the stepped run's own steadiness."""
+    (``orbit.SETTLE``), and the stepped run's own steadiness."""
+    from ..model.orbit import settle_periods
     rows = []
     lo, hi = branch[parameter].min(), branch[parameter].max()
     for _, s in stepped.iterrows():
@@ -480,8 +478,7 @@ def stepped_beside(branch: pd.DataFrame, stepped: pd.DataFrame, parameter: str
             (y, st), mu = there[k], multipliers[k]
             row.update(orbit_tip_h1_cm=y, orbit_stability=st, orbit_max_multiplier=mu,
                        difference_rel=abs(y - s.tip_h1) / max(abs(s.tip_h1), 1e-12),
-                       settle_periods=(np.log(SETTLE) / np.log(mu)
-                                       if st == "stable" and 0 < mu < 1 else np.nan))
+                       settle_periods=(settle_periods(mu) if st == "stable" else np.nan))
         rows.append(row)
     return pd.DataFrame(rows)
 
