@@ -108,6 +108,7 @@ def _next_step(h, err, err_prev, order):
 def _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, set_before, stick_before):
     """Statistics of an accepted step (layout CTL_*) and, above the tolerance, its floor row."""
     ctl[ly.CTL_STEPS] += 1.0
+    ctl[ly.CTL_ARGS + min(arg, 31)] += 1.0
     ctl[ly.CTL_INTERVALS] += 1.0
     ctl[ly.CTL_H_MIN] = min(ctl[ly.CTL_H_MIN], h)
     ctl[ly.CTL_H_MAX] = max(ctl[ly.CTL_H_MAX], h)
@@ -255,6 +256,7 @@ def _rejected(status, err, arg, h, h_floor, order, ctl):
     """Count a rejected step of h (s) and return the step to try next (s): a quarter after
     a failure, else the controller's decrease, at least h_floor."""
     ctl[ly.CTL_REJECTED] += 1.0
+    ctl[ly.CTL_ARGS + 32 + min(arg, 31)] += 1.0
     ctl[ly.CTL_WORK] += 1.0
     if arg >= ly.N_STATE:
         ctl[ly.CTL_REJECTED_EVENTS] += 1.0

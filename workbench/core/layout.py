@@ -378,7 +378,8 @@ CTL_T_SSQ = CTL_Q_SSQ + 1
 # estimate over the tolerance (the PI controller's memory), between calls.
 CTL_H_NEXT = CTL_T_SSQ + 1
 CTL_ERR_PREV = CTL_H_NEXT + 1
-N_CTL = CTL_ERR_PREV + 1
+CTL_ARGS = CTL_ERR_PREV + 1
+N_CTL = CTL_ARGS + 64
 # Error scales scale (2, N_STATE): row SCALE_FLOOR the smallest scale of each
 # component of (q, q'), row SCALE_PEAK its largest |value| so far.
 SCALE_FLOOR, SCALE_PEAK = 0, 1

@@ -248,6 +248,9 @@ def control_summary(ctl: np.ndarray, floor_log: np.ndarray, tol: float, dt: floa
     share_rss = float(np.sqrt(ctl[ly.CTL_T_SSQ])) / duration if duration > 0 else 0.0
     per_level = ctl[ly.CTL_LEVELS:ly.CTL_LEVELS + ly.N_CTL_LEVELS]
     levels = {f"{dt / 2 ** j:.4g}": int(n) for j, n in enumerate(per_level) if n > 0}
+    import numpy as _np
+    global LAST_ARGS
+    LAST_ARGS = _np.array(ctl[ly.CTL_ARGS:ly.CTL_ARGS + 64])
     return {"steps": int(ctl[ly.CTL_STEPS]), "steps_all": int(ctl[ly.CTL_WORK]),
             "intervals": int(ctl[ly.CTL_INTERVALS]), "rejected": int(ctl[ly.CTL_REJECTED]),
             "h_min": float(ctl[ly.CTL_H_MIN]) if done else None,
