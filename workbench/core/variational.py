@@ -43,7 +43,7 @@ from .config import (EVENT_DT_FD_S, JIT, JIT_INLINE, JUMP_FD_REL, RATE_EPS, VAR_
                      VAR_H_MIN_S)
 from . import layout as ly
 from .constrained import project, rhs_regime, tangent_point
-from .contact import fill_geometry, regime_of, row_rate
+from .contact import fill_geometry, regime_of, row_convective, row_rate
 from .event_functions import event_values
 from .hybrid import apply_event, event_transition
 from .integrate import stage_state
@@ -315,14 +315,32 @@ def forced_jump(e, t, y_minus, rg_minus, st_minus, rg_plus, model, ex, work, vw,
 
 
 @nb.njit(**JIT)
-def _slip_sign(y, set_index, P, cg, fallback):
-    """The slip direction (+1 or -1) of a contact set's tangent point at y: the sign of its
-    tangential rate, ``fallback`` where that is below RATE_EPS (slip from rest)."""
+def _slip_sign(t, y, set_index, model, ex, work, f):
+    """(status, sign): the slip direction (+1 or -1) of a contact set's tangent point at y,
+    the sign of its tangential rate, or where that is below RATE_EPS (slip from rest) the
+    consistent one: the direction in which its tangential acceleration points when it slips
+    that way (the friction force against it), of the two the larger (at a stick -> slip
+    event, against the sticking force, as the event applies it).  Leaves work.rg slipping
+    in set_index; f is scratch."""
+    P, cg, rg = model.P, work.cg, work.rg
+    g = ly.CG_T + tangent_point(set_index)
     fill_geometry(y, P, cg)
-    rate = row_rate(cg, ly.CG_T + tangent_point(set_index), y[ly.N_DOF:ly.N_STATE])
-    if abs(rate) <= RATE_EPS:
-        return fallback
-    return 1.0 if rate > 0.0 else -1.0
+    rate = row_rate(cg, g, y[ly.N_DOF:ly.N_STATE])
+    rg[ly.RG_SET] = float(set_index)
+    rg[ly.RG_STICK] = 0.0
+    if abs(rate) > RATE_EPS:
+        return ly.OK, (1.0 if rate > 0.0 else -1.0)
+    best, best_sign = -np.inf, 1.0
+    for sign in (1.0, -1.0):
+        rg[ly.RG_SIGN] = sign
+        status = rhs_regime(t, y, model, ex, work, f)
+        if status != ly.OK:
+            return status, sign
+        at = row_rate(cg, g, f[ly.N_DOF:ly.N_STATE]) + row_convective(cg, g,
+                                                                      y[ly.N_DOF:ly.N_STATE])
+        if sign * at > best:
+            best, best_sign = sign * at, sign
+    return ly.OK, best_sign
 
 
 @nb.njit(**JIT)
@@ -369,12 +387,15 @@ def saltation(e, t, y_minus, st_minus, target, model, ex, work, vw, Phi, ncol):
         return status
     if target >= 0 and regime_in(rg) != target:
         # the enumeration is on a boundary here (a separating force at -LAMBDA_EPS): take
-        # the record's regime, slipping in the direction its tangent point moves
+        # the record's regime, slipping the consistent way (_slip_sign)
         rg[ly.RG_SET] = float((target + 1) // 2)
         rg[ly.RG_STICK] = 1.0 if target % 2 == 1 else 0.0
         if target > 0 and target % 2 == 0:
-            rg[ly.RG_SIGN] = _slip_sign(y_minus, int(rg[ly.RG_SET]), model.P, work.cg,
-                                        vw.rg_minus[ly.RG_SIGN])
+            status, sign = _slip_sign(t, y_minus, int(rg[ly.RG_SET]), model, ex, work,
+                                      f_plus)
+            if status != ly.OK:
+                return status
+            rg[ly.RG_SIGN] = sign
         _copy(rg, vw.rg_plus)
         status = forced_jump(e, t, y_minus, vw.rg_minus, st_minus, vw.rg_plus, model, ex,
                              work, vw, vw.y_plus)
