@@ -9,8 +9,8 @@ and columns are 0).  :func:`variational_span` integrates (y, Phi) together with 
 in P (the run's method): stage r's Phi_r = Phi + h sum_j a_rj K_j and
 K_r = A(t_r, y_r) Phi_r, so that Phi is the Jacobian of the method's own step; the step is
 controlled on both error estimates (y on its error scales, Phi_ik on scale_i times column
-k's size at the start), and y is projected onto the regime's constraints after each step,
-as the run's steps are (:func:`workbench.core.pair.pair_step`).
+k's size vw.column[k], the caller's), and y is projected onto the regime's constraints after
+each step, as the run's steps are (:func:`workbench.core.pair.pair_step`).
 
 At an event at time t_e, with event function h(t, y) (:mod:`workbench.core.event_functions`)
 and jump y+ = G(y-) (:func:`workbench.core.hybrid.apply_event`: the projection onto the

@@ -137,7 +137,8 @@ def variational_monodromy(params, ex: np.ndarray, x: np.ndarray, regime: int, t0
     ncol = basis.shape[1]
     phi = np.zeros((ly.N_STATE, ly.N_STATE))
     phi[:, :ncol] = basis
-    vw.column[:ncol] = np.maximum(np.abs(basis / scale[:, None]).max(axis=0), 1e-300)
+    start_size = np.maximum(np.abs(basis / scale[:, None]).max(axis=0), 1e-300)
+    vw.column[:ncol] = start_size
     t, kinds = float(t0), {}
     rows = [r for r in log if int(r[ly.LOG_KIND]) != ly.KIND_START]
     for n, row in enumerate(rows):
@@ -161,6 +162,11 @@ def variational_monodromy(params, ex: np.ndarray, x: np.ndarray, regime: int, t0
                             np.int64(ncol)), where)
         y[:] = vw.y_plus
         st[:] = vw.st_plus
+        # a column's error is measured against its size since the last event, at least its
+        # start's (a column rocking impacts have grown 6.5e4-fold, at 45 Hz, 200 N, is
+        # otherwise held to a tolerance 6.5e4 times tighter: 19 250 steps for one span)
+        vw.column[:ncol] = np.maximum(start_size,
+                                      np.abs(phi[:, :ncol] / scale[:, None]).max(axis=0))
         kinds[ly.EVENT_KINDS[kind]] = kinds.get(ly.EVENT_KINDS[kind], 0) + 1
     _check(vr.variational_span(t, t0 + period_s, tol, y, phi, model, ex, work, vw),
            "the last span")
