@@ -28,8 +28,8 @@ again at CHECK_FACTOR times the tolerance and the state Jacobian's difference st
 (variational; at a CHECK_FACTOR-th where that one is off by more than FINER_ABOVE) or the
 map's difference step (finite differences) (``multiplier_error``, the largest shift of a
 multiplier).  A variational monodromy that neither settles so (an event whose kind or regime
-after it changes with the tolerance: at 54.7 Hz, 200 N, the largest multiplier 1.04 at one
-tolerance, 1.33 at another) is set beside the finite differences (checked by their own step):
+after it changes with the tolerance) is set beside the finite differences (checked by their
+own step):
 where they agree the error is the larger difference, else the finite differences' multipliers
 are taken (``monodromy`` says so).  The orbit is stable when every
 |multiplier| is below 1 by more than that, unstable when one is above 1 by more, and its
