@@ -12,7 +12,7 @@ from workbench.model import drives
 from workbench.model.continuation import (Bifurcation, Branch, _bifurcation, _tangent,
                                           _turning, _went_back, branch_rows, continue_branch,
                                           continue_from, doublings)
-from workbench.model.orbit import Orbit, Shooter, periodic_orbit
+from workbench.model.orbit import SETTLE, Orbit, Shooter, periodic_orbit
 from workbench.model.params import Parameters
 from workbench.present.branch import write_branch
 
@@ -38,6 +38,9 @@ def test_a_stuck_branch_is_traced_to_its_end_and_written(stuck_branch):
     for column in ("freq_hz", "tip_amplitude_cm", "accel1_amplitude", "strain1_rms",
                    "max_multiplier", "stable", "bifurcation", "impact_per_period"):
         assert column in table, column
+    # the slowest multiplier's settling time: log(SETTLE) / log|mu| periods of 1 / f
+    assert np.allclose(table.settle_s, np.log(SETTLE) / np.log(table.max_multiplier)
+                       / table.freq_hz, rtol=1e-12)
     assert (out / "branch.png").exists() and "Status: done" in (out / "report.md").read_text()
 
 

@@ -500,7 +500,8 @@ def continue_from(shooter: Shooter, rows, lo: float, hi: float,
 def branch_rows(branch: Branch) -> list[dict]:
     """One row per orbit (CGS like the points table): the parameter, the orbit's responses,
     contact shares, events per period, the largest multiplier's modulus and angle (rad; +-pi
-    for a real negative one, as at a period doubling), how the monodromy
+    for a real negative one, as at a period doubling), a stable orbit's ``settle_s``
+    (:meth:`Orbit.settle_s`; nan otherwise), how the monodromy
     was taken, ``stable``, and the ``bifurcation`` between it and the one before with where
     its multiplier crossed the circle (``multiplier_crossing``: +1, -1, complex), that
     multiplier's angle (rad) and the events per period that changed; the section's drive
@@ -520,6 +521,7 @@ def branch_rows(branch: Branch) -> list[dict]:
                "max_multiplier_angle": (float(np.angle(deciding[np.argmax(np.abs(deciding))]))
                                         if len(deciding) else float("nan")),
                "multiplier_error": orbit.multiplier_error,
+               "settle_s": np.nan if orbit.settle_s() is None else orbit.settle_s(),
                "monodromy": orbit.monodromy_method,
                "stable": orbit.stable is True,
                "stability": {True: "stable", False: "unstable", None: "undetermined"}[
