@@ -211,7 +211,7 @@ def _cmd_orbit(args) -> int:
     if args.json:
         print(json_text({key: value for key, value in found.items() if key != "state"}))
     else:
-        mu = orbit.deciding()
+        mu, settle = orbit.deciding(), orbit.settle_s()
         print("\n".join([
             f"{'status':>20}: {orbit.status} ({orbit.message})",
             f"{'period':>20}: {orbit.period_s:.6g} s ({orbit.periods} drive period(s))",
@@ -223,8 +223,8 @@ def _cmd_orbit(args) -> int:
             f"{'contact code':>20}: {found['contact_code']} at phase 0; events per period: "
             + (", ".join(f"{k} {v:g}" for k, v in orbit.events_per_period.items() if v) or "none"),
             f"{'tip amplitude':>20}: {_plain(orbit.tip_amplitude_cm * SI['cm'][1])} mm",
-            *([] if orbit.settle_s() is None else [
-                f"{'settles':>20}: to {SETTLE:g} of a disturbance in {orbit.settle_s():.3g} s "
+            *([] if settle is None else [
+                f"{'settles':>20}: to {SETTLE:g} of a disturbance in {settle:.3g} s "
                 f"(slowest multiplier at {orbit.slowest_hz():.3g} Hz)"]),
             f"{'wall':>20}: {orbit.wall_s:.3g} s"]))
     return EXIT_OK if orbit.status == "ok" else EXIT_NOT_CONVERGED

@@ -521,7 +521,7 @@ def branch_rows(branch: Branch) -> list[dict]:
                "max_multiplier_angle": (float(np.angle(deciding[np.argmax(np.abs(deciding))]))
                                         if len(deciding) else float("nan")),
                "multiplier_error": orbit.multiplier_error,
-               "settle_s": np.nan if orbit.settle_s() is None else orbit.settle_s(),
+               "settle_s": orbit.settle_s() or np.nan,
                "monodromy": orbit.monodromy_method,
                "stable": orbit.stable is True,
                "stability": {True: "stable", False: "unstable", None: "undetermined"}[
