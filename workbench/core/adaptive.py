@@ -50,9 +50,9 @@ from .pair import dense, pair_step, prepare_dense
 #: [FAC_MIN, FAC_MAX], and not above h right after a rejection; after a
 #: rejection h SAFETY err^-1/p, at least FAC_MIN.
 SAFETY = 0.9
-BETA = 0.04
-FAC_MIN = 0.2
-FAC_MAX = 10.0
+BETA = 0.0
+FAC_MIN = 0.333
+FAC_MAX = 6.0
 #: The PI controller's memory before the first step (Hairer's facold).
 ERR_PREV_START = 1e-4
 #: Rows of the event log the driver keeps free before a step; below this it
