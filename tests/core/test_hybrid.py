@@ -239,9 +239,12 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     about -1e-9 to -9.06e-9 cm, its impact event was armed at that depth,
     and its next closing, 1.8e-4 s later at about 113 cm/s, penetrated
     9.06e-9 cm.  Held at g = 0 when the regime is chosen, it leaves from
-    contact, and every closing is found within the event-time tolerance
-    times its speed of GAP_EPS.  Moreau's law with e = 0 loses at least
-    u_n P_n / 2 of kinetic energy, so the closing speed of the impact with
+    contact, and every closing is found within GAP_EPS of the depth that
+    locating it allows: the steps to an event stop past it by at most twice
+    what the gap changes in EVENT_TIME_TOL (``adaptive._step_past``; at the
+    default tolerance this case's deepest is 1.5 times, 2.4e-9 cm at at most
+    160 cm/s; the old projection's 9.06e-9 cm was 8 times).  Moreau's law
+    with e = 0 loses at least u_n P_n / 2 of kinetic energy, so the closing speed of the impact with
     the deepest penetration is at most 2 ke_lost / sum P_n.
     """
     p = Parameters(cork="quadratic").replace(gap_mm=1.016)
@@ -254,7 +257,7 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     assert deepest.t == pytest.approx(run.stats["t_max_penetration"], abs=1e-12)
     impulse = sum(deepest[f"impulse_n{k}"] for k in range(1, 5))
     closing_speed = 2.0 * deepest.ke_lost / impulse                # cm/s, an upper bound
-    assert 0.0 < run.stats["max_penetration_cm"] < closing_speed * EVENT_TIME_TOL + GAP_EPS
+    assert 0.0 < run.stats["max_penetration_cm"] < 2.0 * closing_speed * EVENT_TIME_TOL + GAP_EPS
 
 
 def test_energy_balance_closes_at_a_fine_step():
