@@ -244,8 +244,9 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     what the gap changes in EVENT_TIME_TOL (``adaptive._step_past``; at the
     default tolerance this case's deepest is 1.5 times, 2.4e-9 cm at at most
     160 cm/s; the old projection's 9.06e-9 cm was 8 times).  Moreau's law
-    with e = 0 loses at least u_n P_n / 2 of kinetic energy, so the closing speed of the impact with
-    the deepest penetration is at most 2 ke_lost / sum P_n.
+    with e = 0 loses at least u_n P_n / 2 of kinetic energy, so the closing
+    speed of the impact with the deepest penetration is at most
+    2 ke_lost / sum P_n.
     """
     p = Parameters(cork="quadratic").replace(gap_mm=1.016)
     run = simulate(p, drives.sine(200.0, 45.0, ramp_s=1.0), 2.2)
