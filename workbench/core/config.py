@@ -12,7 +12,7 @@ here, each with what it bounds.
 #: counts; with them, each call of a compiled kernel increments and
 #: decrements every array argument atomically (measured: a call passing 10
 #: arrays 77 ns with the counts, 26 ns without;
-#: docs/performance.md "Compile time").
+#: docs/compile.md).
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy", _nrt=False)
 
 #: Kernels that allocate their own work arrays (the static start, not in the
@@ -34,8 +34,7 @@ CHOLESKY_REL_PIVOT = 1e-14
 #: helper again at every call site, so a helper that grows, or calls big ones,
 #: is a kernel of its own (``JIT``): the aggregates of the equations of motion
 #: (rhs, assemble_inertia, frame_sums, add_applied_forces, add_contact_forces,
-#: fill_geometry, ...) are compiled once and called (docs/performance.md
-#: "Compile time").
+#: fill_geometry, ...) are compiled once and called (docs/compile.md).
 JIT_INLINE = dict(JIT, inline="always")
 
 #: Contact event thresholds (docs/model.md §7).  An event function must pass its

@@ -9,7 +9,7 @@ from numba.core import event as numba_event
 
 
 #: What the first compile of a run's kernels takes on this 2-core machine, from
-#: an idle hour to a busy one (docs/performance.md "Compile time"), for the message.
+#: an idle hour to a busy one (docs/compile.md), for the message.
 COMPILE_NOTE = "15-45 s on 2 cores"
 
 #: The kernels a run uses besides its method's event loop: the model's shape

@@ -1,7 +1,7 @@
 """The workbench's workarounds of numba's compiler, behind one switch.
 
 Three modules change what numba does with this package's kernels, through
-numba's private internals (docs/performance.md "Compile time"):
+numba's private internals (docs/compile.md):
 
 - :mod:`.cache`: the kernels' on-disk cache keyed by a hash of every kernel
   source (numba's checks only the timestamp of a function's own file);

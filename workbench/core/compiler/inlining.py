@@ -17,7 +17,7 @@ call site:
   then renamed into the caller's scope in either case).
 
 Both apply to this package's helpers only; the results are the same to the
-bit.  Measured in docs/performance.md "Compile time".
+bit.  Measured in docs/compile.md.
 """
 from __future__ import annotations
 

@@ -3,8 +3,7 @@
 numba links a callee's LLVM module into every caller's module (its functions
 ``linkonce_odr``) and optimises and emits it there again: the event loop's
 top kernels each carried the machine code of every kernel below them, and
-LLVM spent most of its time on these copies (docs/performance.md "Compile
-time").  For the functions of :mod:`workbench.core`, this module links a
+LLVM spent most of its time on these copies (docs/compile.md).  For the functions of :mod:`workbench.core`, this module links a
 callee's functions ``available_externally`` instead: LLVM still sees their
 bodies (and inlines the small ones as before), but emits no copy; a call that
 is not inlined goes to the callee's own machine code, which the process has
