@@ -21,6 +21,11 @@ accelerations a0 = M^-1 (Q - h):
 
     q'' = a0 + X lambda,   X = M^-1 B^T,   (A X) lambda = -A' q' - A a0.
 
+The rows act on the joint coordinates (s, v, psi) only, so A X needs the
+joint block of M^-1 and X lambda = M^-1 (B^T lambda) one substitution with
+M's factor (:func:`workbench.core.dynamics.joint_block`), whatever the
+number of rows.
+
 The dense systems are at most 3x3 and solved in place in the work array
 ``cw`` (layout ``CW_*``); a row that vanishes on the free coordinates (a
 held coordinate) gets lambda = 0.  Impacts and the choice of the regime
@@ -37,7 +42,7 @@ import numpy as np
 from .config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, NULL_COFACTOR_REL, PIVOT_REL
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
-from .dynamics import rhs, solve_factored
+from .dynamics import add_joint_solve, joint_block, rhs, solve_factored
 
 
 @nb.njit(**JIT_INLINE)
@@ -152,6 +157,28 @@ def _dot9(a, b):
 
 
 @nb.njit(**JIT_INLINE)
+def _dot_joint(a, b):
+    """a . b over the joint coordinates (s, v, psi): a contact row's product."""
+    return a[ly.S] * b[ly.S] + a[ly.V] * b[ly.V] + a[ly.PSI] * b[ly.PSI]
+
+
+@nb.njit(**JIT_INLINE)
+def _fill_joint_delassus(cw, w, m):
+    """D = A M^-1 B^T (rows CW_D, columns 0..m-1) from w, the joint block of M_ff^-1."""
+    for i in range(m):
+        a = cw[ly.CW_A + i]
+        for j in range(m):
+            b = cw[ly.CW_B + j]
+            acc = 0.0
+            for c in range(ly.N_JOINT):
+                wb = 0.0
+                for d in range(ly.N_JOINT):
+                    wb += w[c, d] * b[ly.S + d]
+                acc += a[ly.S + c] * wb
+            cw[ly.CW_D + i, j] = acc
+
+
+@nb.njit(**JIT_INLINE)
 def fill_delassus(free, mat, cw, m):
     """X_r = M^-1 B_r and D = A X (rows CW_D, columns 0..m-1); M's factor must be current."""
     for r in range(m):
@@ -205,17 +232,23 @@ def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
         sign = rg[ly.RG_SIGN]
         fill_geometry(y, P, cg)
         m = set_rows(set_index, stick, sign, P, cg, cw)
-        fill_delassus(free, mat, cw, m)
+        u = cw[ly.CW_X:ly.CW_X + ly.N_JOINT]
+        w = cw[ly.CW_W:ly.CW_W + ly.N_JOINT]
+        joint_block(free, mat, u, w)
+        _fill_joint_delassus(cw, w, m)
         for r in range(m):
             conv = row_convective(cg, row_geometry_index(set_index, stick, r), qd)
-            cw[ly.CW_D + r, ly.CW_C_COL] = -conv - _dot9(cw[ly.CW_A + r], qdd)
+            cw[ly.CW_D + r, ly.CW_C_COL] = -conv - _dot_joint(cw[ly.CW_A + r], qdd)
         small_solve(cw, m)
+        f = cw[ly.CW_X + ly.N_JOINT]          # the contact force on (s, v, psi)
+        for c in range(ly.N_JOINT):
+            acc = 0.0
+            for r in range(m):
+                acc += cw[ly.CW_B + r, ly.S + c] * cw[ly.CW_D + r, ly.CW_L_COL]
+            f[c] = acc
+        add_joint_solve(free, mat, u, f, qdd, cw[ly.CW_W + ly.N_JOINT])
         for r in range(m):
-            lam = cw[ly.CW_D + r, ly.CW_L_COL]
-            x = cw[ly.CW_X + r]
-            for j in range(ly.N_DOF):
-                qdd[j] += x[j] * lam
-            p_constr += lam * _dot9(cw[ly.CW_A + r], qd)
+            p_constr += cw[ly.CW_D + r, ly.CW_L_COL] * _dot_joint(cw[ly.CW_A + r], qd)
         p1 = ly.SET_FIRST[set_index]
         p2 = ly.SET_SECOND[set_index]
         rg[ly.RG_LN + p1] = cw[ly.CW_D + 0, ly.CW_L_COL]

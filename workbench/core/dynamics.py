@@ -250,6 +250,82 @@ def solve_factored(free, mat, b, x):
 
 
 @nb.njit(**JIT_INLINE)
+def _position(free, i):
+    """The factor's row of coordinate i (its place in ``free``), -1 when i is held."""
+    for k in range(free.shape[0]):
+        if free[k] == i:
+            return k
+    return -1
+
+
+@nb.njit(**JIT_INLINE)
+def _joint_block(free, n, all_free, mat, u, w):
+    L = mat[ly.MAT_CHOL]
+    for c in range(ly.N_JOINT):
+        p = ly.S + c if all_free else _position(free, ly.S + c)
+        row = u[c]
+        for k in range(ly.N_DOF):
+            row[k] = 0.0
+        if p < 0:
+            continue
+        row[p] = 1.0
+        for k in range(p + 1, n):
+            acc = 0.0
+            for j in range(p, k):
+                acc -= L[k, j] * row[j]
+            row[k] = acc
+    for c in range(ly.N_JOINT):
+        for d in range(c, ly.N_JOINT):
+            acc = 0.0
+            for k in range(n):
+                acc += u[c, k] * L[k, k] * u[d, k]
+            w[c, d] = acc
+            w[d, c] = acc
+
+
+@nb.njit(**JIT_INLINE)
+def joint_block(free, mat, u, w):
+    """The joint coordinates' (s, v, psi) block of M_ff^-1, from the factor of :func:`factor_free`.
+
+    u[c] (factor rows) = L^-1 e_c for the joint coordinate c (0 when held);
+    w (3, 3) = (M_ff^-1) on (s, v, psi) = u D^-1 u^T, as M^-1 = L^-T D^-1 L^-1.
+    A contact's rows act on these coordinates only (:func:`workbench.core.contact.row_to_dof`),
+    so the contact forces need this block and one substitution
+    (:func:`add_joint_solve`), not a solve per row.
+    """
+    if free.shape[0] == ly.N_DOF:
+        _joint_block(free, ly.N_DOF, True, mat, u, w)
+    else:
+        _joint_block(free, free.shape[0], False, mat, u, w)
+
+
+@nb.njit(**JIT_INLINE)
+def _add_joint_solve(free, n, all_free, mat, u, f, x, z):
+    L = mat[ly.MAT_CHOL]
+    for k in range(n):
+        acc = 0.0
+        for c in range(ly.N_JOINT):
+            acc += u[c, k] * f[c]
+        z[k] = acc * L[k, k]
+    for i in range(n - 1, -1, -1):
+        acc = z[i]
+        for k in range(i + 1, n):
+            acc -= L[k, i] * z[k]
+        z[i] = acc
+        x[_at(free, i, all_free)] += acc
+
+
+@nb.njit(**JIT_INLINE)
+def add_joint_solve(free, mat, u, f, x, z):
+    """x += M_ff^-1 (f on (s, v, psi)): a force f (3,) on the joint coordinates, with u of
+    :func:`joint_block`; z (9,) is scratch."""
+    if free.shape[0] == ly.N_DOF:
+        _add_joint_solve(free, ly.N_DOF, True, mat, u, f, x, z)
+    else:
+        _add_joint_solve(free, free.shape[0], False, mat, u, f, x, z)
+
+
+@nb.njit(**JIT_INLINE)
 def solve_free(free, mat, b, x):
     """Solve M_ff x_f = b_f by its LDL^T factor (M = mat[MAT_M]); x of fixed coordinates = 0.
 

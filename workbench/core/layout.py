@@ -15,6 +15,8 @@ State ``y = (q, qdot)`` of length 18.
 # --- generalised coordinates -------------------------------------------------
 W_A, PHI_A, U_A, S, V, PSI, W_B, PHI_B, U_B = range(9)
 N_DOF = 9
+#: The joint coordinates S, V, PSI (consecutive): the only ones a contact row acts on.
+N_JOINT = 3
 N_STATE = 2 * N_DOF
 COORD_NAMES = ("w_A", "phi_A", "u_A", "s", "v", "psi", "w_B", "phi_B", "u_B")
 #: Units of each coordinate (CGS).
@@ -271,8 +273,9 @@ N_RG = RG_ARM + N_POINTS
 
 # Constraint work array cw (N_CW, N_CW_COLS): up to 4 constraint rows A (the
 # normal and tangential rows of two points), their force directions B (A when
-# sticking; W_n - mu sigma W_t when slipping), the columns X = M^-1 B^T, a
-# small dense system D lambda = c; then the impact law's Delassus matrix G,
+# sticking; W_n - mu sigma W_t when slipping), the columns X = M^-1 B^T (or,
+# in the right-hand side, L^-1 e of the joint coordinates), a small dense
+# system D lambda = c, the joint block of M^-1; then the impact law's
 # rates u, impulses P, modes and friction coefficients, and its scratch rows
 # (workbench.core.impact_law).  Rows A, B, X use the first N_DOF columns.
 MAX_ROWS = 4
@@ -281,8 +284,8 @@ CW_B = CW_A + MAX_ROWS
 CW_X = CW_B + MAX_ROWS
 CW_D = CW_X + MAX_ROWS       # rows CW_D..: D in columns 0..3, c in column 4, lambda in 5
 CW_C_COL, CW_L_COL = MAX_ROWS, MAX_ROWS + 1
-CW_G = CW_D + MAX_ROWS       # rows CW_G..CW_G + 3: G in columns 0..3
-CW_U = CW_G + MAX_ROWS       # u- (cm/s) of the impact rows
+CW_W = CW_D + MAX_ROWS       # rows CW_W..: the joint coordinates' block of M^-1 (columns 0..2)
+CW_U = CW_W + MAX_ROWS       # u- (cm/s) of the impact rows
 CW_P = CW_U + 1              # impulses P (dyn s)
 CW_MODES = CW_P + 1          # per point: impact_law.OPEN, STICK, SLIP_POS, SLIP_NEG
 CW_MU = CW_MODES + 1         # per point: mu
