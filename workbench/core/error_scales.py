@@ -10,7 +10,11 @@ velocity scale.
 """
 import numba as nb
 
+import os
 from .config import JIT, JIT_INLINE, REF_RATE
+#: Experiment: the forces' error scales times FORCE_MULT (environment; a compile-time
+#: constant, so give each value its own WORKBENCH_CACHE_ROOT).
+FORCE_MULT = float(os.environ.get('FORCE_MULT', '1'))
 from . import layout as ly
 
 #: The coordinate sharing a component's scale: a beam tip's deflection and
@@ -65,4 +69,4 @@ def event_scale(e, P, scale, ctl):
     if e == ly.EV_SLIP:
         return max(scale[ly.SCALE_FLOOR, ly.N_DOF + ly.S], scale[ly.SCALE_PEAK, ly.N_DOF + ly.S],
                    scale[ly.SCALE_PEAK, ly.N_DOF + ly.V])
-    return max(ctl[ly.CTL_F_SCALE], P[ly.P_M4] * P[ly.P_GRAV])
+    return FORCE_MULT * max(ctl[ly.CTL_F_SCALE], P[ly.P_M4] * P[ly.P_GRAV])
