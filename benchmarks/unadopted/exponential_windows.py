@@ -1,7 +1,7 @@
 """Exponential integrators against DOP853 on the smooth spans between events (not adopted).
 
     python benchmarks/unadopted/exponential_windows.py tip|notip [--spans N] [--span-ms T]
-        [--methods dop853,exprb43,etdrk4,etdrk4-K]
+        [--methods dop853,exprb43,etdrk4,etdrk4-K,etdrk4-agoD]
 
 From the 10 s sine (1.016 mm, 20 Hz, 200 N, cubic cork, the default method) it takes N
 spans of T ms that hold no event (each starting at an output sample, in the regime the
@@ -15,7 +15,10 @@ projection) with fixed steps of
   an augmented matrix, time as a 19th state;
 * ETDRK4 (Cox & Matthews, J. Comput. Phys. 176 (2002)) with the Jacobian of the span's
   start frozen over the span (``etdrk4``) or taken again every K steps (``etdrk4-K``): 4
-  right-hand sides a step, the Jacobian and phi functions once a span or every K steps.
+  right-hand sides a step, the Jacobian and phi functions once a span or every K steps;
+  ``etdrk4-agoD``: the Jacobian frozen, taken D ms before the span's start at the state the
+  run had then, where that state was in the span's regime (the spans without one are left
+  out of that row).
 
 Errors at the span's end against scipy's DOP853 at rtol 1e-12: the state's on the
 workbench's scales (each component over the run's largest |value| of it or its partner,
@@ -142,16 +145,18 @@ def exprb43(f, t0, y0, T, n, counts):
     return w[:N]
 
 
-def etdrk4(f, t0, y0, T, n, counts, refresh=0):
+def etdrk4(f, t0, y0, T, n, counts, refresh=0, w_jac=None):
     """Cox & Matthews ETDRK4 with L the Jacobian at the span's start, frozen (or taken again
-    every ``refresh`` steps); on w = (y, t)."""
+    every ``refresh`` steps, or taken at the earlier state w_jac = (y, t) of the same regime);
+    on w = (y, t)."""
     def F(w):
         return np.append(f(w[N], w[:N]), 1.0)
     h = T / n
     w = np.append(y0, t0)
 
     def operator(w):
-        L = jacobian(F, w, F(w))
+        at = w if w_jac is None else w_jac
+        L = jacobian(F, at, F(at))
         counts["expm"] += 2
         p1h, = phis(0.5 * h * L, 1)
         p1, p2, p3 = phis(h * L, 3)
@@ -196,6 +201,20 @@ def spans(run, n_spans, span_s, t_min=2.0):
     return out
 
 
+def earlier_state(run, t0, regime, ago):
+    """(y, t) of the output sample ``ago`` s before t0 if the run was in ``regime`` from there
+    (no event between) or, failing that, in the same regime then; else None."""
+    i = np.searchsorted(run.t, t0 - ago)
+    if i >= len(run.t) or i == 0:
+        return None
+    t1 = run.t[i]
+    times = run.log[:, ly.LOG_T]
+    k = np.searchsorted(times, t1, side="right")
+    if k == 0 or int(run.log[k - 1, ly.LOG_TO]) != regime or t1 - times[k - 1] < 1e-6:
+        return None
+    return np.append(run.states[i, :N], t1)
+
+
 def scales(run):
     peak = np.abs(run.states[:, :N]).max(axis=0)
     s = np.empty(N)
@@ -211,7 +230,8 @@ def main():
     ap.add_argument("--spans", type=int, default=12)
     ap.add_argument("--span-ms", type=float, default=2.0)
     ap.add_argument("--methods", default="dop853,exprb43,etdrk4",
-                    help="dop853, exprb43, etdrk4 (L frozen over the span), etdrk4-K (L every K steps)")
+                    help="dop853, exprb43, etdrk4 (L frozen over the span), etdrk4-K (L every K "
+                         "steps), etdrk4-agoD (L of the regime D ms before)")
     a = ap.parse_args()
     p = Parameters().replace(gap_mm=1.016, tip_mass=a.case == "tip", cork="cubic")
     ex = sine(200.0, 20.0, ramp_s=1.0)
@@ -230,6 +250,9 @@ def main():
         ref = solve_ivp(f, (t0, t0 + T), y0, method="DOP853", rtol=1e-12, atol=1e-14 * scale).y[:, -1]
         lam_ref, lt_ref = f.forces(t0 + T, ref)
         for method in a.methods.split(","):
+            earlier = None
+            if method.startswith("etdrk4-ago"):
+                earlier = earlier_state(run, t0, regime, float(method[10:]) * 1e-3)
             for n in steps:
                 counts = {"expm": 0}
                 f.calls = 0
@@ -240,6 +263,10 @@ def main():
                         y = exprb43(f, t0, y0, T, n, counts)
                     elif method == "etdrk4":
                         y = etdrk4(f, t0, y0, T, n, counts)
+                    elif method.startswith("etdrk4-ago"):   # L of the regime D ms before
+                        if earlier is None:
+                            continue
+                        y = etdrk4(f, t0, y0, T, n, counts, 0, earlier)
                     else:                                   # etdrk4-K: L every K steps
                         y = etdrk4(f, t0, y0, T, n, counts, int(method.split("-")[1]))
                     calls = f.calls
@@ -251,11 +278,11 @@ def main():
                 except (RuntimeError, FloatingPointError, ValueError):   # unstable: no result
                     calls, err, ferr = f.calls, np.inf, np.inf
                 table.setdefault((method, n), []).append((err, ferr, calls, counts["expm"]))
-    print(f"{'method':8s} {'h (s)':>9s} {'state err med':>13s} {'max':>9s} {'force err med':>13s} "
+    print(f"{'method':12s} {'n':>3s} {'h (s)':>9s} {'state err med':>13s} {'max':>9s} {'force err med':>13s} "
           f"{'max':>9s} {'RHS/ms':>8s} {'expm/ms':>8s}")
     for (method, n), rows in table.items():
         e = np.array(rows)
-        print(f"{method:8s} {T / n:9.2e} {np.median(e[:, 0]):13.2e} {e[:, 0].max():9.2e} "
+        print(f"{method:12s} {len(rows):3d} {T / n:9.2e} {np.median(e[:, 0]):13.2e} {e[:, 0].max():9.2e} "
               f"{np.median(e[:, 1]):13.2e} {e[:, 1].max():9.2e} {e[:, 2].mean() / (T * 1e3):8.0f} "
               f"{e[:, 3].mean() / (T * 1e3):8.1f}")
 
