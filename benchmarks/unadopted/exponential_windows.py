@@ -1,7 +1,7 @@
 """Exponential integrators against DOP853 on the smooth spans between events (not adopted).
 
     python benchmarks/unadopted/exponential_windows.py tip|notip [--spans N] [--span-ms T]
-        [--methods dop853,exprb43,etdrk4,etdrk4-K,etdrk4-agoD]
+        [--steps 2,4,8,16,32] [--methods dop853,exprb43,etdrk4,etdrk4-K,etdrk4-agoD]
 
 From the 10 s sine (1.016 mm, 20 Hz, 200 N, cubic cork, the default method) it takes N
 spans of T ms that hold no event (each starting at an output sample, in the regime the
@@ -229,6 +229,7 @@ def main():
     ap.add_argument("case", choices=("tip", "notip"))
     ap.add_argument("--spans", type=int, default=12)
     ap.add_argument("--span-ms", type=float, default=2.0)
+    ap.add_argument("--steps", default="2,4,8,16,32", help="steps a span, comma-separated")
     ap.add_argument("--methods", default="dop853,exprb43,etdrk4",
                     help="dop853, exprb43, etdrk4 (L frozen over the span), etdrk4-K (L every K "
                          "steps), etdrk4-agoD (L of the regime D ms before)")
@@ -243,7 +244,7 @@ def main():
     chosen = spans(run, a.spans, T)
     regimes = [r for _, _, r in chosen]
     print(f"{a.case}: {len(chosen)} spans of {a.span_ms} ms, regimes {sorted(set(regimes))}")
-    steps = [2, 4, 8, 16, 32]
+    steps = [int(n) for n in a.steps.split(",")]
     table = {}
     for t0, y0, regime in chosen:
         f = RegimeODE(p, ex, regime, y0)
