@@ -15,7 +15,7 @@ from workbench.model.limits import DEFAULT_TOL
 from workbench.model.params import ParameterError, Parameters
 from workbench.model.step_policy import default_dt
 from workbench.model.simulate import simulate
-from workbench.model.tableaus import DOPRI5, write_tableau
+from workbench.model.tableaus import DOP853, DOPRI5, write_tableau
 
 ALL = set(ly.COORD_NAMES)
 JOINT_HELD = ("s", "v", "psi")
@@ -249,3 +249,55 @@ def test_an_accumulating_case_converges_with_the_tolerance_as_with_the_step():
         assert r.ok and r.summary()["accumulations"] > 0 and r.summary()["stepped_steps"] == 0
     assert abs(n["tight"] - n["fixed"]) <= abs(n["tol"] - n["fixed"]) + 2
     assert abs(n["tight"] - n["fixed"]) / n["fixed"] < 0.01, n
+
+
+@pytest.mark.parametrize("d", [6e-8, -6e-8])
+def test_a_short_step_to_an_event_agrees_with_a_step_of_the_pair_there(rocking, d):
+    """A step of the pair moved on by a Heun step of d (the kernel's correction of at most
+    SHORT_STEP_S towards an event) against a step of the pair from the same start to that
+    time, in the regime the rocking run ends in (contact forces acting), on the kernel's error
+    scales: they agree within a thousandth of the tolerance, though the state moved by a
+    thousand times that."""
+    from workbench.core.adaptive import _short_step
+    from workbench.core.config import SHORT_STEP_S
+    from workbench.core.contact import eval_geometry
+    from workbench.core.error_scales import PARTNER
+    assert abs(d) <= SHORT_STEP_S
+    p, ex = rocking
+    run = simulate(p, ex, 0.05, initial="paper")
+    regime = int(run.log[-1, ly.LOG_TO])
+    assert regime > 0, "the test needs a contact regime"
+    model = mdl.build(p)
+    write_tableau(model.P, DOP853)
+    work = mdl.make_work()
+    work.rg[ly.RG_SET] = (regime + 1) // 2
+    work.rg[ly.RG_STICK] = 1.0 if regime % 2 == 1 else 0.0
+    st = np.zeros(ly.N_ST)
+    y0 = np.zeros(ly.N_AUG)
+    y0[:ly.N_STATE] = run.states[-1]
+    eval_geometry(y0[:ly.N_DOF], model.P, work.cg)      # slipping: along the slip rate
+    row = work.cg[ly.CG_T + ly.SET_FIRST[(regime + 1) // 2]]
+    qd = y0[ly.N_DOF:ly.N_STATE]
+    rate = row[ly.CG_DS] * qd[ly.S] + row[ly.CG_DV] * qd[ly.V] + row[ly.CG_DPSI] * qd[ly.PSI]
+    work.rg[ly.RG_SIGN] = 1.0 if rate >= 0.0 else -1.0
+    t, h = run.t[-1], 1e-4
+    last = int(model.P[ly.P_RK_STAGES]) - 1
+    stages = work.stages
+
+    def pair_to(step, out):
+        assert rhs_regime(t, y0, model, ex, work, stages[ly.STAGE_K1]) == ly.OK
+        work.ev[:] = 1.0
+        assert pair_step(t, y0, step, model, ex, work, st, out) == ly.OK
+
+    pair_to(h, stages[ly.STAGE_BASE])
+    stages[ly.STAGE_KBASE] = stages[last]
+    assert _short_step(t + h, d, model, ex, work, st) == ly.OK
+    short = stages[ly.STAGE_HI, :ly.N_STATE].copy()
+    direct = np.empty(ly.N_AUG)
+    pair_to(h + d, direct)
+    peak = np.abs(run.states).max(axis=0)       # the kernel's error scales (error_scales)
+    scale = np.array([max(peak[i], peak[PARTNER[i % ly.N_DOF] + i // ly.N_DOF * ly.N_DOF])
+                      for i in range(ly.N_STATE)])
+    gap = np.max(np.abs(short - direct[:ly.N_STATE]) / scale)
+    moved = np.max(np.abs(short - stages[ly.STAGE_BASE, :ly.N_STATE]) / scale)
+    assert gap < 1e-3 * DEFAULT_TOL and moved > 1e3 * gap, (gap, moved)   # 7.5e-9, 4.6e-5

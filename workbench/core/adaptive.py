@@ -33,10 +33,10 @@ import math
 import numba as nb
 import numpy as np
 
-from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP, STEP_REMAINDER_REL,
-                     STEPPED_TIME_S)
+from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP,
+                     SHORT_STEP_S, STEP_REMAINDER_REL, STEPPED_TIME_S)
 from . import layout as ly
-from .constrained import rhs_regime
+from .constrained import project, rhs_regime
 from .contact import regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
 from .event_functions import event_values_after_rhs
@@ -151,6 +151,31 @@ PAST_ITERS = 40
 SLOPE_FRACTION = 1e-3
 
 
+@nb.njit(**JIT_INLINE)
+def _short_step(t, d, model, ex, work, st):
+    """A Heun step of d (s, either sign, |d| <= SHORT_STEP_S) from the pair's state at t
+    (STAGE_BASE, its right-hand side in STAGE_KBASE) into STAGE_HI, projected onto the
+    regime's constraints; its right-hand side in STAGE_KTRY and its forces in rg."""
+    P, free = model.P, model.free
+    stages, cg, cw, rg = work.stages, work.cg, work.cw, work.rg
+    y0 = stages[ly.STAGE_BASE]
+    k0 = stages[ly.STAGE_KBASE]
+    y = stages[ly.STAGE_HI]
+    k = stages[ly.STAGE_KTRY]
+    yp = stages[ly.STAGE_TMP]
+    for i in range(ly.N_AUG):
+        yp[i] = y0[i] + d * k0[i]
+    status = rhs_regime(t + d, yp, model, ex, work, k)
+    if status != ly.OK:
+        return status
+    for i in range(ly.N_AUG):
+        y[i] = y0[i] + 0.5 * d * (k0[i] + k[i])
+    correction, drift = project(y, P, free, cg, cw, rg, np.bool_(False))
+    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
+    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+    return rhs_regime(t + d, y, model, ex, work, k)
+
+
 @nb.njit(**JIT)
 def _step_past(e, theta, t, h, model, ex, work, st):
     """The state just past event e by steps of the pair from the step's start (into STAGE_HI).
@@ -164,8 +189,10 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     pair's steps have found (an event function may have a kink there: a
     double contact's stick margin), moves theta until the pair's state is
     past the event by about what the function changes in EVENT_TIME_TOL, or
-    the bracket is EVENT_TIME_TOL wide.  Returns ``(status, theta)``; the
-    events at the state in EV_HI.
+    the bracket is EVENT_TIME_TOL wide.  A move of at most SHORT_STEP_S from
+    the last step of the pair is a short step from its state
+    (:func:`_short_step`).  Returns ``(status, theta)``; the events at the
+    state in EV_HI.
     """
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
@@ -179,12 +206,22 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     depth = max(-slope * push, 1e-300)
     lo, hi = 0.0, 2.0            # exact f >= 0 at lo (the step's start), < 0 at hi (if <= 1)
     x = theta
+    base = -1.0                  # the fraction of the last step of the pair (STAGE_BASE)
+    last = int(P[ly.P_RK_STAGES]) - 1
     for _ in range(PAST_ITERS):
         if x >= 1.0:
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
-        status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st, stages[ly.STAGE_HI])
+        if base >= 0.0 and abs(x - base) * h <= SHORT_STEP_S:
+            status = _short_step(t + base * h, (x - base) * h, model, ex, work, st)
+        else:
+            status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st,
+                               stages[ly.STAGE_HI])
+            if status == ly.OK:
+                base = x
+                _copy(stages, ly.STAGE_HI, ly.STAGE_BASE)
+                _copy(stages, last, ly.STAGE_KBASE)
         if status != ly.OK:
             return status, x
         event_values_after_rhs(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)

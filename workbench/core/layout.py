@@ -222,10 +222,12 @@ N_VEC = 4   # gravity energy (erg), excitation power (erg/s), shaker and hammer 
 # found past an event), STAGE_KNEXT and STAGE_KTRY the right-hand sides at
 # STAGE_NEXT and STAGE_TRY; STAGE_QD holds q'- in [0, 9) and a candidate
 # q'+ in [9, 18) during an impact.
-# STAGE_ERR holds an embedded pair's error estimate of the step (workbench.core.pair).
+# STAGE_ERR holds an embedded pair's error estimate of the step (workbench.core.pair);
+# STAGE_BASE and STAGE_KBASE a step of the pair towards an event and its right-hand side,
+# from which short steps move on to the event (workbench.core.adaptive).
 (STAGE_TMP, STAGE_CUR, STAGE_NEXT, STAGE_K1, STAGE_TRY, STAGE_HI, STAGE_KNEXT, STAGE_KTRY,
- STAGE_QD, STAGE_ERR) = range(MAX_RK_STAGES, MAX_RK_STAGES + 10)
-N_STAGES = MAX_RK_STAGES + 10
+ STAGE_QD, STAGE_ERR, STAGE_BASE, STAGE_KBASE) = range(MAX_RK_STAGES, MAX_RK_STAGES + 12)
+N_STAGES = MAX_RK_STAGES + 12
 
 # --- augmented state -----------------------------------------------------------
 # The integrators carry (q, q') and these running integrals (erg), integrated
