@@ -215,7 +215,9 @@ def _step_past(e, theta, t, h, model, ex, work, st):
             return ly.OK, 1.0
         if base >= 0.0 and abs(x - base) * h <= SHORT_STEP_S:
             status = _short_step(t + base * h, (x - base) * h, model, ex, work, st)
+            rg[ly.RG_CNT + 3] += 1.0
         else:
+            rg[ly.RG_CNT + 4] += 1.0
             status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st,
                                stages[ly.STAGE_HI])
             if status == ly.OK:
@@ -224,6 +226,8 @@ def _step_past(e, theta, t, h, model, ex, work, st):
                 _copy(stages, last, ly.STAGE_KBASE)
         if status != ly.OK:
             return status, x
+        rg[ly.RG_CNT + 2] += 1.0
+        rg[ly.RG_CNT + 5] = max(rg[ly.RG_CNT + 5], abs(x - theta) * h)
         event_values_after_rhs(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
         f = ev[ly.EV_HI, e]
         if f < 0.0:
@@ -329,7 +333,10 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
     the event e (-1: none), its fraction theta of the step)."""
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    c0 = rg[ly.RG_CNT]
     status = pair_step(t, y, h_try, model, ex, work, st, stages[ly.STAGE_NEXT])
+    rg[ly.RG_CNT + 15] += rg[ly.RG_CNT] - c0
+    c0 = rg[ly.RG_CNT]
     err = np.inf
     arg = -1
     force = 0.0
@@ -337,16 +344,21 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
         event_values_after_rhs(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
         force = total_normal_force(rg)
         status, err, arg = step_error(tol, model, ex, work, scale, ctl, t + h_try)
+    rg[ly.RG_CNT + 16] += rg[ly.RG_CNT] - c0
+    c0 = rg[ly.RG_CNT]
     e = -1
     theta = 2.0
     acceptable = err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)
     if status == ly.OK and acceptable and P[ly.P_RK_EXTRA] > 0.0:
         status = prepare_dense(t, y, h_try, model, ex, work)
+    rg[ly.RG_CNT + 17] += rg[ly.RG_CNT] - c0
+    c0 = rg[ly.RG_CNT]
     if status == ly.OK and acceptable:
         ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
         for k in range(ly.N_EV):
             ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
         status, e, theta = locate(t, h_try, np.bool_(True), model, ex, work)
+        rg[ly.RG_CNT + 14] += rg[ly.RG_CNT] - c0
         if status == ly.OK and e >= 0:
             te = _event_time_error(e, theta * h_try, ev, ev_err)
             r = te / (tol * EVENT_TIME_SCALE_S)
@@ -389,9 +401,14 @@ def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
     the pair from the step's start to just past it, then the event and any impact it sets
     off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log)."""
     stages, rg, ev = work.stages, work.rg, work.ev
+    c0 = rg[ly.RG_CNT]
     status, theta = _step_past(e, theta, t, h, model, ex, work, st)
+    rg[ly.RG_CNT + 11] += rg[ly.RG_CNT] - c0
+    c0 = rg[ly.RG_CNT]
     if status == ly.OK:
         status, e, theta = _earlier_on_steps(e, theta, t, h, model, ex, work)
+    rg[ly.RG_CNT + 12] += rg[ly.RG_CNT] - c0
+    c0 = rg[ly.RG_CNT]
     if status != ly.OK:
         st[ly.ST_T] = t
         return status, t, n_log
@@ -413,6 +430,8 @@ def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
             return status, t, n_log
         n_log += 1
         e = _immediate_impact(ev)
+    rg[ly.RG_CNT + 13] += rg[ly.RG_CNT] - c0
+    rg[ly.RG_CNT + 20] += n_step_events
     return ly.OK, t, n_log
 
 
@@ -480,6 +499,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
     t = t0
     rejected = False                         # the last step tried was rejected
+    rejected_after_event = False
     m_stop = step0 + n_steps                 # the base step the call ends at
     full = False
     b_next = (step0 // decim + 1) * decim    # the next sample's base step
@@ -504,9 +524,13 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         h_try = min(h, h_max, t_stop - t)
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
+        c1 = rg[ly.RG_CNT]
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
+            rg[ly.RG_CNT + 19] += rg[ly.RG_CNT] - c1
+            if rejected_after_event:
+                rg[ly.RG_CNT + 21] += 1.0
             h = _rejected(status, err, arg, h_try, h_floor, order, ctl)
             rejected = True
             continue
@@ -518,11 +542,14 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
         if e < 0 and h_try == t_stop - t:
             t_end = t_stop
+        rejected_after_event = e >= 0
+        c1 = rg[ly.RG_CNT]
         # samples in (t, t_end]: the dense output of this step (or its end)
         status, stored, b_next = _samples(t, t_end, h_try, e < 0, y, (t0, step0, dt, decim, m_stop),
                                           (stored, b_next), model, ex, work, st, out)
         if status != ly.OK:
             return status, stored, n_log
+        rg[ly.RG_CNT + 18] += rg[ly.RG_CNT] - c1
         if e < 0:
             _take_step(stages, ev, last)
             t = t_end

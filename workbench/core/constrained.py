@@ -171,6 +171,7 @@ def rhs_regime(t, y, model, ex, work, ydot):
     """
     P, tab, kc, free = model.P, model.tab, model.kc, model.free
     rec, mat, vec, cg, cw, rg = work.rec, work.mat, work.vec, work.cg, work.cw, work.rg
+    rg[ly.RG_CNT] += 1.0
     status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
     if status != ly.OK:
         return status

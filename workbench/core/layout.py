@@ -269,7 +269,8 @@ RG_LN = 3        # RG_LN + k: normal force lambda_n of point k + 1 (dyn), 0 if o
 RG_LT = RG_LN + N_POINTS   # sticking: tangential force lambda_t (dyn)
 RG_VGRAV = RG_LT + 1       # gravitational energy of the last state (erg)
 RG_ARM = RG_VGRAV + 1      # RG_ARM + k: an open gap's impact fires at g_k < -rg[RG_ARM + k] (cm)
-N_RG = RG_ARM + N_POINTS
+RG_CNT = RG_ARM + N_POINTS
+N_RG = RG_CNT + 40
 
 # Constraint work array cw (N_CW, N_CW_COLS): up to 4 constraint rows A (the
 # normal and tangential rows of two points), their force directions B (A when
