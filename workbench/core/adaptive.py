@@ -21,7 +21,8 @@ on the dense output): a sign change between the step's ends, or an event
 function negative at one of the step's stages or, for a gap turning within
 the step, at its Hermite minimum, is checked on the dense output and
 located there by Brent's method to EVENT_TIME_TOL; then one step of the
-pair from the step's start to the event gives the state there, the event
+pair from the step's start to the event, moved on by short steps
+(SHORT_STEP_S) to within EVENT_TIME_TOL of it, gives the state there, the event
 is applied (:func:`workbench.core.hybrid.apply_event`) and the next step
 starts from it with the step size kept.  Samples are the dense output at
 the output times.  An event flood (FLOOD_EVENTS within FLOOD_WINDOW_S) hands
