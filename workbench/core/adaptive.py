@@ -37,14 +37,14 @@ import numpy as np
 from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP,
                      SHORT_STEP_S, STEP_REMAINDER_REL, STEPPED_TIME_S)
 from . import layout as ly
-from .constrained import project, rhs_regime
+from .constrained import rhs_regime
 from .contact import regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
 from .event_functions import event_values_after_rhs
 from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _stepped, _trial,
                      apply_event, begin, flooding, locate, passed_before, penetration, step_end,
                      store)
-from .pair import dense, pair_step, prepare_dense
+from .pair import dense, pair_step, prepare_dense, project_step_end
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
 #: h_new = h SAFETY err^-(1/p - 0.75 BETA) err_prev^BETA, by a factor in
@@ -171,9 +171,7 @@ def _short_step(t, d, model, ex, work, st):
         return status
     for i in range(ly.N_AUG):
         y[i] = y0[i] + 0.5 * d * (k0[i] + k[i])
-    correction, drift = project(y, P, free, cg, cw, rg, np.bool_(False))
-    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
-    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+    project_step_end(y, P, free, cg, cw, rg, st)
     return rhs_regime(t + d, y, model, ex, work, k)
 
 

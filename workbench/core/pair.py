@@ -37,6 +37,14 @@ def _stage_events_min(yt, P, free, cg, rg, ev):
         ev[ly.EV_MIN, e] = min(ev[ly.EV_MIN, e], ev[ly.EV_TRY, e])
 
 
+@nb.njit(**JIT_INLINE)
+def project_step_end(y, P, free, cg, cw, rg, st):
+    """Project a step's end y onto the regime's constraints; the projection's size into st."""
+    correction, drift = project(y, P, free, cg, cw, rg, np.bool_(False))
+    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
+    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+
+
 @nb.njit(**JIT)
 def pair_step(t, y, h, model, ex, work, st, y_new):
     """One step of h (s) of the pair in P from (t, y) into y_new (may not alias y).
@@ -71,9 +79,7 @@ def pair_step(t, y, h, model, ex, work, st, y_new):
         y_new[i] = y[i] + h * acc
         if not math.isfinite(y_new[i]):
             return ly.ERR_NAN
-    correction, drift = project(y_new, P, free, cg, cw, rg, np.bool_(False))
-    st[ly.ST_MAX_CORRECTION] = max(st[ly.ST_MAX_CORRECTION], correction)
-    st[ly.ST_MAX_DRIFT] = max(st[ly.ST_MAX_DRIFT], drift)
+    project_step_end(y_new, P, free, cg, cw, rg, st)
     status = rhs_regime(t + h, y_new, model, ex, work, stages[s - 1])
     if status != ly.OK:
         return status
