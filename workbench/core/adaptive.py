@@ -320,6 +320,22 @@ def _accepted(step, force, tol, before, model, work, control):
         ctl[ly.CTL_T_SSQ] += te * te
 
 
+@nb.njit(**JIT_INLINE)
+def _event_in_step(ev):
+    """Whether :func:`workbench.core.hybrid.locate` will look inside the step (on the dense
+    output): an event function not negative at the step's start and negative at its end, at
+    one of its stages, or a gap turning within it."""
+    for e in range(ly.N_EV):
+        if ev[ly.EV_START, e] < 0.0:
+            continue
+        if ev[ly.EV_END, e] < 0.0 or ev[ly.EV_MIN, e] < -ev[ly.EV_NOISE, e]:
+            return True
+        if (e < ly.EV_GAP + ly.N_POINTS and ev[ly.EV_RATE_START, e] < 0.0
+                and ev[ly.EV_RATE_END, e] > 0.0 and ev[ly.EV_START, e] < 1.0):
+            return True
+    return False
+
+
 @nb.njit(**JIT)
 def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
     """A step of the pair of h_try (s) from (t, y) into STAGE_NEXT, its error estimate over
@@ -339,7 +355,7 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
     e = -1
     theta = 2.0
     acceptable = err <= 1.0 or h_try <= h_floor * (1.0 + 1e-9)
-    if status == ly.OK and acceptable and P[ly.P_RK_EXTRA] > 0.0:
+    if status == ly.OK and acceptable and _event_in_step(ev):
         status = prepare_dense(t, y, h_try, model, ex, work)
     if status == ly.OK and acceptable:
         ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
@@ -365,6 +381,7 @@ def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
     stored, b_next = counts
     P, stages = model.P, work.stages
     out_t, out_y, out_sig = out
+    ready = not whole or _event_in_step(work.ev)    # the dense stages computed already
     while b_next <= m_stop:
         t_sample = t0 + (b_next - step0) * dt
         if t_sample > t_end + STEP_REMAINDER_REL * dt:
@@ -372,6 +389,11 @@ def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
         x = (t_sample - t) / h
         y_s = stages[ly.STAGE_NEXT]
         if not (whole and x >= 1.0 - 1e-12):
+            if not ready:
+                status = prepare_dense(t, y, h, model, ex, work)
+                if status != ly.OK:
+                    return status, stored, b_next
+                ready = True
             y_s = stages[ly.STAGE_HI]
             dense(min(x, 1.0), h, y, P, stages, y_s)
         status = store(stored, t_sample, y_s, model, ex, work, st, out_t, out_y, out_sig)
