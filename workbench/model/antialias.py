@@ -78,7 +78,7 @@ def internal_decimation(decim: int, dt: float, f_model_hz: float) -> int:
     """Base steps between the kernels' samples: the largest divisor k of ``decim`` (the
     base steps between output samples) with 1 / (k dt) >= 2 f_model_hz + the output rate."""
     out_hz = 1.0 / (decim * dt)
-    need = f_model_hz + out_hz
+    need = 2.0 * f_model_hz + out_hz
     for k in range(decim, 0, -1):
         if decim % k == 0 and 1.0 / (k * dt) >= need * (1.0 - 1e-12):
             return k
