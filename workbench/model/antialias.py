@@ -3,7 +3,7 @@ sampled at the output rate.
 
 A data acquisition system filters every analog channel below half its sample rate
 before it samples, so that nothing above that frequency folds into the record.  A run
-does the same.  The kernels sample the solution at an internal rate F = 1 / (k dt)
+does the same from samples of the solution.  The kernels sample the solution at an internal rate F = 1 / (k dt)
 (:func:`internal_decimation`: the coarsest that is still above 2 f_model + f, with
 f_model the linear model's fastest mode and f the output rate, so that none of the
 model's modes folds into the record's band; with the default step k = 1, F = 10 kHz
@@ -18,8 +18,10 @@ sample is kept (m = F / f):
 - the filter is centred (an output sample at t weighs the internal samples t +- H dt
   symmetrically), so it has no delay: a DAQ's timestamps are corrected for its own
   filter's delay in the same way;
-- a record is valid (alias-free and flat within the ripple) from 0 to PASSBAND f:
-  400 Hz at the default 1 kHz.
+- a record is valid (flat within the ripple, nothing of the model's modes folded) from 0
+  to PASSBAND f: 400 Hz at the default 1 kHz.  What the internal samples fold from above
+  F / 2 stays: the accelerations, which jump at the events, differ from the same trajectory
+  sampled at 4 F by up to 0.2-1.2 % of their range (docs/usage.md).
 
 The edges: before the run's first sample each channel is held at its first value (the
 rig at rest in its start state); after the last it is continued by point reflection
