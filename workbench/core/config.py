@@ -13,7 +13,7 @@ here, each with what it bounds.
 #: decrements every array argument atomically (measured: a call passing 10
 #: arrays 77 ns with the counts, 26 ns without;
 #: docs/compile.md).
-JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy", _nrt=False)
+JIT = dict(cache=True, nogil=True, fastmath={"contract", "arcp", "nsz", "reassoc", "afn"}, error_model="numpy", _nrt=False)
 
 #: Kernels that allocate their own work arrays (the static start, not in the
 #: time loop).
