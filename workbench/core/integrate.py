@@ -28,14 +28,10 @@ def stage_state(r, t, y, h, P, stages, yt):
     """Stage r's state y + h sum_{j<r} a_rj k_j (k_j in stages[j]) into yt; returns its time."""
     row = ly.P_RK_A + ly.MAX_RK_STAGES * r
     for i in range(ly.N_AUG):
-        yt[i] = 0.0
-    for j in range(r):
-        a = P[row + j]
-        if a != 0.0:
-            for i in range(ly.N_AUG):
-                yt[i] += a * stages[j, i]
-    for i in range(ly.N_AUG):
-        yt[i] = y[i] + h * yt[i]
+        acc = 0.0
+        for j in range(r):
+            acc += P[row + j] * stages[j, i]
+        yt[i] = y[i] + h * acc
     return t + P[ly.P_RK_C + r] * h
 
 
