@@ -253,13 +253,13 @@ def main():
         ew.phis, ew.sla = scipy_phis, scipy_sla
         rows.append((regime, sq, t_jac * 1e6, t_phi * 1e6, errs[0], errs[1], t_eig * 1e6))
         print(f"regime {regime:2d}  squarings {sq:2d}  Jacobian {t_jac * 1e6:6.1f} us  "
-              f"phi set {t_phi * 1e6:6.1f} us  eig {t_eig * 1e6:6.1f} us  ETDRK4 error, scipy phi {errs[0]:.2e}, "
-              f"compiled {errs[1]:.2e}", flush=True)
+              f"phi set {t_phi * 1e6:6.1f} us  eig {t_eig * 1e6:6.1f} us  "
+              f"ETDRK4 error, scipy phi {errs[0]:.2e}, compiled {errs[1]:.2e}", flush=True)
     r = np.array(rows)
-    print(f"{a.case}: {len(rows)} spans, h = {h:.3g} s; medians: Jacobian {np.median(r[:, 2]):.1f} us, "
-          f"phi set {np.median(r[:, 3]):.1f} us, eig {np.median(r[:, 6]):.1f} us (squarings {np.median(r[:, 1]):.0f}); largest "
-          f"ETDRK4 error scipy {r[:, 4].max():.2e}, compiled {r[:, 5].max():.2e}")
-
+    med = np.median(r, axis=0)
+    print(f"{a.case}: {len(rows)} spans, h = {h:.3g} s; medians: Jacobian {med[2]:.1f} us, "
+          f"phi set {med[3]:.1f} us, eig {med[6]:.1f} us (squarings {med[1]:.0f}); "
+          f"largest ETDRK4 error scipy {r[:, 4].max():.2e}, compiled {r[:, 5].max():.2e}")
 
 if __name__ == "__main__":
     main()
