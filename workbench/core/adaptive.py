@@ -41,10 +41,11 @@ from .constrained import rhs_regime
 from .contact import regime_of
 from .error_scales import event_scale, floors, grow_scales, state_scale, total_normal_force
 from .event_functions import event_values_after_rhs
-from .hybrid import (_bracket, _copy, _copy_ev, _immediate_impact, _stepped, _trial,
+from .hybrid import (GRAZE_MARGIN, _hermite_min, _bracket, _copy, _copy_ev, _immediate_impact, _stepped, _trial,
                      apply_event, begin, flooding, locate, passed_before, penetration, step_end,
                      store)
 from .pair import dense, pair_step, prepare_dense, project_step_end
+from . import exponential as xp
 
 #: The PI controller (Hairer, Norsett & Wanner I, §IV.2; DOPRI5's defaults):
 #: h_new = h SAFETY err^-(1/p - 0.75 BETA) err_prev^BETA, by a factor in
@@ -309,7 +310,7 @@ def _accepted(step, force, tol, before, model, work, control):
     ``before`` is the regime's (set, stick) before the step."""
     t, h, err, arg, dt, e, theta = step
     P, stages, rg, ev = model.P, work.stages, work.rg, work.ev
-    ctl, scale, floor_log = control
+    ctl, scale, floor_log = control[0], control[1], control[2]
     ctl[ly.CTL_WORK] += 1.0
     _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, before[0], before[1])
     grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
@@ -353,6 +354,53 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
                 err = r
                 arg = ly.N_STATE + ly.N_EV
     return status, err, arg, force, e, theta
+
+
+@nb.njit(**JIT)
+def _try_exp_step(t, y, h, mid, tol, model, ex, work, st, scale, ctl, expo):
+    """An ETDRK4 step of h (s) from (t, y) into STAGE_NEXT (:mod:`workbench.core.exponential`),
+    with the regime's operators (taken again when older than the age set or for another h),
+    its error estimate over the tolerance as _try_step.  Returns (status, err, arg, the total
+    normal force, whether the step may be kept: no event function is a candidate in it)."""
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    ops, opkey, sc = expo
+    k = xp.regime_key(rg)
+    if not (t - opkey[k, 0] <= opkey[xp.KEY_SET, 1] and opkey[k, 1] == h):
+        opkey[xp.KEY_COUNT, 0] += 1.0
+        status = xp.operators(t, y, h, model, ex, work, ops[k], sc)
+        if status != ly.OK:
+            return status, np.inf, -1, 0.0, False
+        opkey[k, 0] = t
+        opkey[k, 1] = h
+    status = xp.etd_step(t, y, h, model, ex, work, st, ops[k], stages[ly.STAGE_NEXT], mid)
+    if status != ly.OK:
+        return status, np.inf, -1, 0.0, False
+    event_values_after_rhs(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+    force = total_normal_force(rg)
+    status, err, arg = step_error(tol, model, ex, work, scale, ctl, t + h)
+    if status != ly.OK:
+        return status, np.inf, -1, 0.0, False
+    for e in range(ly.N_EV):
+        f0 = ev[ly.EV_START, e]
+        if f0 < 0.0:
+            continue
+        turning = (e < ly.EV_GAP + ly.N_POINTS and ev[ly.EV_RATE_START, e] < 0.0
+                   and ev[ly.EV_RATE_END, e] > 0.0 and f0 < 1.0)
+        if turning:     # the cubic Hermite minimum clear of zero by the graze margin (hybrid)
+            m0 = h * ev[ly.EV_RATE_START, e]
+            m1 = h * ev[ly.EV_RATE_END, e]
+            turning = not _hermite_min(f0, ev[ly.EV_END, e], m0, m1)[1] >= GRAZE_MARGIN * (m1 - m0)
+        if ev[ly.EV_END, e] < 0.0 or turning or ev[ly.EV_MIN, e] < -ev[ly.EV_NOISE, e]:
+            opk = expo[1]
+            if ev[ly.EV_END, e] < 0.0:
+                opk[xp.KEY_ARG + 40 + e, 0] += 1.0
+            elif turning:
+                opk[xp.KEY_ARG + 50 + e, 0] += 1.0
+            else:
+                opk[xp.KEY_ARG + 60 + e, 0] += 1.0
+            return ly.OK, err, arg, force, False
+    return ly.OK, err, arg, force, True
 
 
 @nb.njit(**JIT)
@@ -459,6 +507,10 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     stages, rg, ev = work.stages, work.rg, work.ev
     out_t, out_y, out_sig = out
     ctl, scale = control[0], control[1]
+    expo = (control[3], control[4], control[5])
+    opkey = control[4]
+    exp_on = opkey[xp.KEY_SET, 0] != 0.0
+    exp_failed_t = -np.inf
     if _bad_input(y0, span, tolerance, P, out, log):
         return ly.ERR_BAD_INPUT, 0, 0
     y = stages[ly.STAGE_CUR]
@@ -503,6 +555,50 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         h_try = min(h, h_max, t_stop - t)
         set_before = int(rg[ly.RG_SET])
         stick_before = rg[ly.RG_STICK] != 0.0
+        if exp_on:
+            H = decim * dt
+            t_next = t0 + (b_next - step0) * dt
+            on_lattice = abs(t - (t_next - H)) <= 1e-9 * dt
+            two = opkey[xp.KEY_MODE, 0] == 2.0
+            t_end = t_next + H if two else t_next
+            if (on_lattice and t_end <= t_stop + 1e-9 * dt and h >= 0.7 * H
+                    and t != exp_failed_t and b_next + (decim if two else 0) <= m_stop):
+                h_exp = 2.0 * H if two else H
+                status, err, arg, force, keep = _try_exp_step(t, y, h_exp, two,
+                                                               tol * opkey[xp.KEY_MODE, 2], model,
+                                                               ex, work, st, scale, ctl, expo)
+                if status != ly.OK or err > 1.0 or not keep:
+                    opkey[xp.KEY_FALL, 0] += 1.0
+                    if status == ly.OK and err > 1.0:
+                        opkey[xp.KEY_FALL, 1] += 1.0
+                        opkey[xp.KEY_ARG + min(int(math.log10(err) * 4), 39), 1] += 1.0
+                        opkey[xp.KEY_ARG + min(arg, 39), 0] += 1.0
+                    exp_failed_t = t
+                    continue
+                opkey[xp.KEY_COUNT, 1] += 1.0
+                opkey[xp.KEY_MODE, 1] = max(opkey[xp.KEY_MODE, 1], err)
+                _accepted((t, t_end - t, err, arg, dt, -1, 2.0), force, tol,
+                          (set_before, stick_before), model, work, control)
+                if two:
+                    status = store(stored, t_next, stages[xp.STAGE_MID], model, ex, work, st,
+                                   out_t, out_y, out_sig)
+                    if status != ly.OK:
+                        return status, stored, n_log
+                    stored += 1
+                    b_next += decim
+                status, stored, b_next = _samples(t, t_end, t_end - t, True, y,
+                                                  (t0, step0, dt, decim, m_stop),
+                                                  (stored, b_next), model, ex, work, st, out)
+                if status != ly.OK:
+                    return status, stored, n_log
+                _take_step(stages, ev, last)
+                t = t_end
+                step_end(t, y, rg, ev, st)
+                continue
+            if not on_lattice and t_next < t + h_try:
+                landing = t_next + H * math.floor((t + h_try - t_next) / H + 1e-12)
+                if landing - t >= 0.3 * h_try:
+                    h_try = landing - t
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):

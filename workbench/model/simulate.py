@@ -18,12 +18,13 @@ event computed before it (``run.status``, ``run.message``).  Units are CGS
 """
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
 
 from . import packing as mdl
-from ..core import excitation as cx, layout as ly
+from ..core import excitation as cx, exponential, layout as ly
 from . import accuracy, antialias, kernel_loading
 from .drives import none
 from .initial_state import initial_state
@@ -111,6 +112,17 @@ def simulate(params: Parameters, excitation: np.ndarray | None = None, duration:
     run.method, run.tol = method, tol
     run.control = (control_summary(controller[0][0], controller[0][2], tol, dt, duration)
                    if controller else fixed_step_summary(dt, int(record.st[ly.ST_STEP])))
+    if controller:
+        opkey = controller[0][4]
+        run.control.update(etd_operators=int(opkey[exponential.KEY_COUNT, 0]),
+                           etd_steps=int(opkey[exponential.KEY_COUNT, 1]),
+                           etd_fallbacks=int(opkey[exponential.KEY_FALL, 0]),
+                           etd_fall_err=int(opkey[exponential.KEY_FALL, 1]),
+                           etd_err_max=float(opkey[exponential.KEY_MODE, 1]),
+                           etd_err_hist={i / 4: int(v) for i, v in
+                                         enumerate(opkey[exponential.KEY_ARG:, 1]) if v},
+                           etd_fall_arg={i: int(v) for i, v in
+                                         enumerate(opkey[exponential.KEY_ARG:, 0]) if v})
     if check_accuracy and run.ok:
         finer = accuracy.companion_settings(METHODS[method].controlled, tol, dt)
         companion = simulate(params, excitation, duration, output_hz=1.0 / (decim * dt),
@@ -128,7 +140,12 @@ def _controller(controlled: bool, tol, level_max) -> tuple[tuple, tuple]:
         return (), ()
     ctl = np.zeros(ly.N_CTL)
     ctl[ly.CTL_H_MIN] = np.inf
-    return ((ctl, np.zeros((ly.N_SCALE_ROWS, ly.N_STATE)), np.zeros((FLOOR_LOG_ROWS, ly.N_FLOOR))),), \
+    expo = exponential.new_arrays(os.environ.get("WORKBENCH_ETD", "0") == "1",
+                                  float(os.environ.get("WORKBENCH_ETD_AGE", "0.01")))
+    expo[1][exponential.KEY_MODE, 0] = float(os.environ.get("WORKBENCH_ETD_SAMPLES", "1"))
+    expo[1][exponential.KEY_MODE, 2] = float(os.environ.get("WORKBENCH_ETD_TOLX", "1"))
+    return ((ctl, np.zeros((ly.N_SCALE_ROWS, ly.N_STATE)), np.zeros((FLOOR_LOG_ROWS, ly.N_FLOOR)),
+             *expo),), \
         ((tol, int(level_max)),)
 
 
