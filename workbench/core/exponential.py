@@ -57,6 +57,8 @@ N_SCRATCH = SC_PHI + 8 + 1
 FD_REL = 1e-7
 #: The row of stages the state at the step's middle goes to.
 STAGE_MID = 12
+#: The row of stages the last-stage estimate goes to (compared by etd_step_check.py only).
+STAGE_ALT_ERR = 13
 
 
 def new_arrays(enabled, age_s):
@@ -325,4 +327,11 @@ def etd_step(t, y, h, model, ex, work, st, ops, y_new, mid):
         err[i] = 0.0 if i < N else h / 3.0 * (Fa[i] + Fb[i] - Fc[i] - Fw[i])
         tmp[i] = Da[i] + Db[i] - Dc[i]
     _mv_add(ops[OP_B23], tmp, 0.0, 1.0, err)
+    # for comparison only (etd_step_check.py): the last-stage estimate of classical RK4's kind,
+    # h (4 phi3 - phi2)(Z) (D_new - D_c), into stages[STAGE_ALT_ERR]
+    alt = stages[STAGE_ALT_ERR]
+    _increment(Fn, Fc, L, y_new, c, 0.0, tmp)
+    for i in range(ly.N_AUG):
+        alt[i] = 0.0 if i < N else h / 6.0 * (Fn[i] - Fc[i])
+    _mv_add(ops[OP_B4], tmp, 0.0, 1.0, alt)
     return ly.OK
