@@ -152,6 +152,11 @@ PIVOT_REL = 1e-12
 #: Two contacts' 3 x 4 rows have no common null direction when every 3 x 3
 #: cofactor is below this times the cube of the rows' scale.
 NULL_COFACTOR_REL = 1e-12
+#: A sticking double contact locks the joint (and its accelerations are solved
+#: by blocks, constrained.locked_joint_accelerations) when the determinant of its
+#: 3 x 3 rows on (s, v, psi) exceeds this fraction of Hadamard's bound; below it
+#: (rows nearly dependent) the pivoted elimination of add_contact_forces decides.
+LOCK_DET_REL = 1e-6
 
 # --- controlled --------------------------------------------------------------
 #: An event's time is controlled on this scale (s): its estimated error (the

@@ -34,10 +34,11 @@ their rates onto the active rows.
 import numba as nb
 import numpy as np
 
-from .config import FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, NULL_COFACTOR_REL, PIVOT_REL
+from .config import (FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, LOCK_DET_REL, NULL_COFACTOR_REL,
+                     PIVOT_REL)
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
-from .dynamics import rhs, solve_factored
+from .dynamics import net_forces, rhs, solve_beams, solve_factored
 
 
 @nb.njit(**JIT_INLINE)
@@ -167,18 +168,119 @@ def rhs_regime(t, y, model, ex, work, ydot):
 
     Writes ydot (N_AUG,): (q', q'') and the powers integrated for the
     energy account (erg/s); the contact forces lambda (dyn) into rg.
-    Returns a status code.
+    Returns a status code.  A sticking double contact whose rows lock the
+    joint takes :func:`locked_joint_accelerations`, the same equations
+    solved by blocks.
     """
     P, tab, kc, free = model.P, model.tab, model.kc, model.free
     rec, mat, vec, cg, cw, rg = work.rec, work.mat, work.vec, work.cg, work.cw, work.rg
-    status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
+    set_index = int(rg[ly.RG_SET])
+    locked = False
+    if rg[ly.RG_STICK] != 0.0 and ly.SET_SECOND[set_index] >= 0 and free.shape[0] == ly.N_DOF:
+        fill_geometry(y, P, cg)
+        locked = joint_locked(set_index, cg)
+    if locked:
+        net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)
+        status = locked_joint_accelerations(y, mat, vec[ly.VEC_RHS], cg, rg, ydot)
+    else:
+        status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
     if status != ly.OK:
         return status
     rg[ly.RG_VGRAV] = vec[ly.VEC_AUX, ly.AUX_VGRAV]
     ydot[ly.A_WORK] = vec[ly.VEC_AUX, ly.AUX_P_EXT]
     ydot[ly.A_DAMP] = vec[ly.VEC_AUX, ly.AUX_P_DAMP]
     ydot[ly.A_CORK] = P[ly.P_CORK_C] * y[ly.N_DOF + ly.S] * y[ly.N_DOF + ly.S]
-    add_contact_forces(y, P, free, mat, cg, cw, rg, ydot)
+    if not locked:
+        add_contact_forces(y, P, free, mat, cg, cw, rg, ydot)
+    return ly.OK
+
+
+@nb.njit(**JIT_INLINE)
+def _joint_row(cg, row):
+    """A geometry row's gradient on the joint's coordinates (s, v, psi)."""
+    return (cg[row, ly.CG_DS], cg[row, ly.CG_DV], cg[row, ly.CG_DPSI])
+
+
+@nb.njit(**JIT_INLINE)
+def _locked_rows(set_index):
+    """The geometry rows of a sticking double contact: both normals, the first point's tangent."""
+    return (ly.CG_G + ly.SET_FIRST[set_index], ly.CG_G + ly.SET_SECOND[set_index],
+            ly.CG_T + tangent_point(set_index))
+
+
+@nb.njit(**JIT_INLINE)
+def joint_locked(set_index, cg):
+    """Do the rows of a sticking double contact (cg current) span the joint's coordinates?
+
+    True when the determinant of the 3 x 3 rows on (s, v, psi) exceeds
+    LOCK_DET_REL of Hadamard's bound (the product of the rows' lengths).
+    """
+    g1, g2, gt = _locked_rows(set_index)
+    a = _joint_row(cg, g1)
+    b = _joint_row(cg, g2)
+    c = _joint_row(cg, gt)
+    bound = 1.0
+    for r in (a, b, c):
+        bound *= (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) ** 0.5
+    return abs(_det3(a, b, c)) > LOCK_DET_REL * bound
+
+
+@nb.njit(**JIT)
+def locked_joint_accelerations(y, mat, b, cg, rg, ydot):
+    """q'' and the contact forces of a sticking double contact that locks the joint.
+
+    The regime's rows A (the two normals, the first point's tangent) are
+    zero on the beams' coordinates r and an invertible 3 x 3 block A_j on
+    the joint's j = (s, v, psi), so M q'' = b + A^T lambda with
+    A q'' = -A' q' splits into blocks: A_j q_j'' = -A' q',
+    M_rr q_r'' = b_r - M_rj q_j'', A_j^T lambda = M_j. q'' - b_j.  These are
+    the equations of :func:`add_contact_forces`, without the solves with M
+    on the joint's rows.  M in mat[MAT_M] and b = Q - h must be y's; b's
+    beam rows are left as b_r - M_rj q_j'' and mat[MAT_CHOL] with the
+    factor of M_rr.  Writes q'' into ydot,
+    lambda (dyn) into rg and the constraint and friction powers (erg/s).
+    Returns a status code.
+    """
+    M = mat[ly.MAT_M]
+    qd = y[ly.N_DOF:ly.N_STATE]
+    qdd = ydot[ly.N_DOF:ly.N_STATE]
+    set_index = int(rg[ly.RG_SET])
+    rows = _locked_rows(set_index)
+    a = _joint_row(cg, rows[0])
+    bb = _joint_row(cg, rows[1])
+    c = _joint_row(cg, rows[2])
+    inv_det = 1.0 / _det3(a, bb, c)
+    conv = (-row_convective(cg, rows[0], qd), -row_convective(cg, rows[1], qd),
+            -row_convective(cg, rows[2], qd))
+    # the joint's accelerations by Cramer's rule on the columns of A_j
+    c0 = (a[0], bb[0], c[0])
+    c1 = (a[1], bb[1], c[1])
+    c2 = (a[2], bb[2], c[2])
+    qj = (_det3(conv, c1, c2) * inv_det, _det3(c0, conv, c2) * inv_det,
+          _det3(c0, c1, conv) * inv_det)
+    for i in ly.BEAM_COORDS:
+        b[i] -= M[i, ly.S] * qj[0] + M[i, ly.V] * qj[1] + M[i, ly.PSI] * qj[2]
+    status = solve_beams(mat, b, qdd)
+    if status != ly.OK:
+        return status
+    qdd[ly.S] = qj[0]
+    qdd[ly.V] = qj[1]
+    qdd[ly.PSI] = qj[2]
+    # b_j was not changed: the residual of the joint's rows is A_j^T lambda
+    res = (_dot9(M[ly.S], qdd) - b[ly.S], _dot9(M[ly.V], qdd) - b[ly.V],
+           _dot9(M[ly.PSI], qdd) - b[ly.PSI])
+    lam = (_det3(res, bb, c) * inv_det, _det3(a, res, c) * inv_det, _det3(a, bb, res) * inv_det)
+    for k in range(ly.N_POINTS):
+        rg[ly.RG_LN + k] = 0.0
+        ydot[ly.A_FRIC_P + k] = 0.0
+    rg[ly.RG_LN + ly.SET_FIRST[set_index]] = lam[0]
+    rg[ly.RG_LN + ly.SET_SECOND[set_index]] = lam[1]
+    rg[ly.RG_LT] = lam[2]
+    p_constr = 0.0
+    for r in range(3):
+        p_constr += lam[r] * row_rate(cg, rows[r], qd)
+    ydot[ly.A_FRIC] = 0.0
+    ydot[ly.A_CONSTR] = p_constr
     return ly.OK
 
 

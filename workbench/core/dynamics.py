@@ -262,12 +262,11 @@ def solve_free(free, mat, b, x):
 
 
 @nb.njit(**JIT)
-def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
-    """First-order right-hand side y' = (q', q'') of the 18-state system in free flight.
+def net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot):
+    """M (mat[MAT_M]) and b = Q - h (vec[VEC_RHS]) at y; q' into ydot[:N_DOF].
 
-    Units: y = (q, q') in cm, rad and their rates; t in s.  Returns a status.
-    Leaves M's LDL^T factor in mat[MAT_CHOL] and the scalars of
-    vec[VEC_AUX] (gravity energy, excitation power and forces).
+    Units: dyn, dyn cm.  Leaves the scalars of vec[VEC_AUX] (gravity energy,
+    excitation power and forces).
     """
     q = y[:ly.N_DOF]
     qd = y[ly.N_DOF:]
@@ -279,7 +278,31 @@ def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
     b = vec[ly.VEC_RHS]
     for i in range(ly.N_DOF):
         b[i] = Q[i] - vec[ly.VEC_H, i]
-    return solve_free(free, mat, b, ydot[ly.N_DOF:])
+
+
+@nb.njit(**JIT)
+def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
+    """First-order right-hand side y' = (q', q'') of the 18-state system in free flight.
+
+    Units: y = (q, q') in cm, rad and their rates; t in s.  Returns a status.
+    Leaves M's LDL^T factor in mat[MAT_CHOL] and the scalars of
+    vec[VEC_AUX] (gravity energy, excitation power and forces).
+    """
+    net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)
+    return solve_free(free, mat, vec[ly.VEC_RHS], ydot[ly.N_DOF:])
+
+
+@nb.njit(**JIT_INLINE)
+def solve_beams(mat, b, x):
+    """Solve M_rr x_r = b_r over the beams' coordinates r (ly.BEAM_COORDS), the joint's held.
+
+    Factors M_rr (M = mat[MAT_M]) into mat[MAT_CHOL]; x of the joint's
+    coordinates = 0.  Returns a status code.
+    """
+    status = _factor(ly.BEAM_COORDS, 6, False, mat)
+    if status == ly.OK:
+        _solve(ly.BEAM_COORDS, 6, False, mat, b, x)
+    return status
 
 
 @nb.njit(**JIT)

@@ -16,6 +16,8 @@ State ``y = (q, qdot)`` of length 18.
 W_A, PHI_A, U_A, S, V, PSI, W_B, PHI_B, U_B = range(9)
 N_DOF = 9
 N_STATE = 2 * N_DOF
+#: The beams' coordinates: all but the joint's (s, v, psi).
+BEAM_COORDS = (W_A, PHI_A, U_A, W_B, PHI_B, U_B)
 COORD_NAMES = ("w_A", "phi_A", "u_A", "s", "v", "psi", "w_B", "phi_B", "u_B")
 #: Units of each coordinate (CGS).
 COORD_UNITS = ("cm", "rad", "cm", "cm", "cm", "rad", "cm", "rad", "cm")
