@@ -32,13 +32,14 @@ GROUPS = {
         ("inertia.frame_sums", "kinematics.compute_frames", "dynamics.assemble_inertia",
          "sin/cos (libm)"),
     "right-hand side: applied forces, M's factor and solve":
-        ("dynamics.rhs", "dynamics.add_applied_forces"),
-    "right-hand side: contact forces (constraint rows, Delassus, solve)":
+        ("dynamics.rhs", "dynamics.net_forces", "dynamics.add_applied_forces"),
+    "right-hand side: contact forces (constraint rows, Delassus, solve; the locked joint's blocks)":
         ("constrained.add_contact_forces", "constrained.rhs_regime",
+         "constrained.locked_joint_accelerations",
          "constrained.stick_margin", "contact.fill_geometry"),
     "the pair's stage sums, estimate and dense output":
         ("pair.pair_step", "pair.dense", "pair.prepare_dense"),
-    "event functions": ("event_functions.event_values",),
+    "event functions": ("event_functions.event_values", "event_functions.event_values_after_rhs"),
     "projection onto the regime's constraints":
         ("constrained.project", "constrained._project_rows", "constrained._project_gaps"),
     "samples (sensors, storage)": ("sensors.fill_signals", "hybrid.store", "adaptive._samples"),
