@@ -65,7 +65,7 @@ LOG_RESERVE = 4 * (MAX_EVENTS_PER_STEP + 2)
 def step_error(tol, model, ex, work, scale, ctl, t):
     """The step's estimate over ``tol``: the new state at STAGE_NEXT, its events in EV_END.
 
-    The embedded solution y_new - err (STAGE_TRY) is evaluated in the same
+    The embedded solution's (q, q'), y_new - err (STAGE_TRY), is evaluated in the same
     regime, its event functions into EV_TRY (its contact forces overwrite
     rg's).  Returns ``(status, estimate, component)``: the component of
     (q, q') (0..17) or the event function (N_STATE + e) with the largest ratio.
@@ -82,7 +82,7 @@ def step_error(tol, model, ex, work, scale, ctl, t):
             worst = r
             arg = i
     y_hat = stages[ly.STAGE_TRY]
-    for i in range(ly.N_AUG):
+    for i in range(ly.N_STATE):
         y_hat[i] = y_new[i] - err[i]
     if int(rg[ly.RG_SET]) > 0:
         status = rhs_regime(t, y_hat, model, ex, work, stages[ly.STAGE_KTRY])

@@ -164,14 +164,24 @@ def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
     aux[ly.AUX_P_EXT] = power
 
 
-@nb.njit(**JIT_INLINE)
-def _at(free, i, all_free):
-    """Coordinate of the i-th free row: i itself when every coordinate is free."""
-    return i if all_free else free[i]
+#: Which rows the factor and solves take (``rows`` of :func:`_at`): the coordinates listed in
+#: ``free``, every coordinate, or the beams' (ly.BEAM_COORDS: the joint's three skipped).
+LISTED, ALL_FREE, BEAMS_ONLY = 0, 1, 2
 
 
 @nb.njit(**JIT_INLINE)
-def _factor(free, n, all_free, mat):
+def _at(free, i, rows):
+    """Coordinate of the i-th row: free[i], i itself with every coordinate free, or the
+    i-th of the beams' coordinates (the joint's s, v, psi are 3..5)."""
+    if rows == ALL_FREE:
+        return i
+    if rows == BEAMS_ONLY:
+        return i if i < ly.S else i + 3
+    return free[i]
+
+
+@nb.njit(**JIT_INLINE)
+def _factor(free, n, rows, mat):
     """LDL^T factor of M_ff (n free rows) into mat[MAT_CHOL]; returns a status.
 
     Stores the unit lower triangle L below the diagonal, 1 / D_j on it and
@@ -186,10 +196,10 @@ def _factor(free, n, all_free, mat):
     M = mat[ly.MAT_M]
     big = 0.0
     for i in range(n):
-        fi = _at(free, i, all_free)
+        fi = _at(free, i, rows)
         big = max(big, M[fi, fi])
     for j in range(n):
-        fj = _at(free, j, all_free)
+        fj = _at(free, j, rows)
         d = M[fj, fj]
         for k in range(j):
             d -= L[j, k] * L[k, j]
@@ -198,7 +208,7 @@ def _factor(free, n, all_free, mat):
         inv = 1.0 / d
         L[j, j] = inv
         for i in range(j + 1, n):
-            acc = M[_at(free, i, all_free), fj]
+            acc = M[_at(free, i, rows), fj]
             for k in range(j):
                 acc -= L[i, k] * L[k, j]
             L[j, i] = acc
@@ -216,37 +226,37 @@ def factor_free(free, mat):
     µs per factor).
     """
     if free.shape[0] == ly.N_DOF:
-        return _factor(free, ly.N_DOF, True, mat)
-    return _factor(free, free.shape[0], False, mat)
+        return _factor(free, ly.N_DOF, ALL_FREE, mat)
+    return _factor(free, free.shape[0], LISTED, mat)
 
 
 @nb.njit(**JIT_INLINE)
-def _solve(free, n, all_free, mat, b, x):
+def _solve(free, n, rows, mat, b, x):
     L = mat[ly.MAT_CHOL]
     for i in range(ly.N_DOF):
         x[i] = 0.0
     # forward L z = b, scale y = D^-1 z, back L^T x = y (kept in x's free slots)
     for i in range(n):
-        acc = b[_at(free, i, all_free)]
+        acc = b[_at(free, i, rows)]
         for k in range(i):
-            acc -= L[i, k] * x[_at(free, k, all_free)]
-        x[_at(free, i, all_free)] = acc
+            acc -= L[i, k] * x[_at(free, k, rows)]
+        x[_at(free, i, rows)] = acc
     for i in range(n):
-        x[_at(free, i, all_free)] *= L[i, i]
+        x[_at(free, i, rows)] *= L[i, i]
     for i in range(n - 1, -1, -1):
-        acc = x[_at(free, i, all_free)]
+        acc = x[_at(free, i, rows)]
         for k in range(i + 1, n):
-            acc -= L[k, i] * x[_at(free, k, all_free)]
-        x[_at(free, i, all_free)] = acc
+            acc -= L[k, i] * x[_at(free, k, rows)]
+        x[_at(free, i, rows)] = acc
 
 
 @nb.njit(**JIT_INLINE)
 def solve_factored(free, mat, b, x):
     """x = M_ff^-1 b_f with the factor of :func:`factor_free`; x of fixed coordinates = 0."""
     if free.shape[0] == ly.N_DOF:
-        _solve(free, ly.N_DOF, True, mat, b, x)
+        _solve(free, ly.N_DOF, ALL_FREE, mat, b, x)
     else:
-        _solve(free, free.shape[0], False, mat, b, x)
+        _solve(free, free.shape[0], LISTED, mat, b, x)
 
 
 @nb.njit(**JIT_INLINE)
@@ -299,9 +309,9 @@ def solve_beams(mat, b, x):
     Factors M_rr (M = mat[MAT_M]) into mat[MAT_CHOL]; x of the joint's
     coordinates = 0.  Returns a status code.
     """
-    status = _factor(ly.BEAM_COORDS, 6, False, mat)
+    status = _factor(ly.BEAM_COORDS, 6, BEAMS_ONLY, mat)
     if status == ly.OK:
-        _solve(ly.BEAM_COORDS, 6, False, mat, b, x)
+        _solve(ly.BEAM_COORDS, 6, BEAMS_ONLY, mat, b, x)
     return status
 
 

@@ -25,16 +25,20 @@ from .constrained import rhs_regime
 
 @nb.njit(**JIT_INLINE)
 def stage_state(r, t, y, h, P, stages, yt):
-    """Stage r's state y + h sum_{j<r} a_rj k_j (k_j in stages[j]) into yt; returns its time."""
+    """Stage r's state y + h sum_{j<r} a_rj k_j (k_j in stages[j]) into yt; returns its time.
+
+    Only (q, q') (N_STATE): no right-hand side reads the energy integrals,
+    so yt's are left as they are.
+    """
     row = ly.P_RK_A + ly.MAX_RK_STAGES * r
-    for i in range(ly.N_AUG):
+    for i in range(ly.N_STATE):
         yt[i] = 0.0
     for j in range(r):
         a = P[row + j]
         if a != 0.0:
-            for i in range(ly.N_AUG):
+            for i in range(ly.N_STATE):
                 yt[i] += a * stages[j, i]
-    for i in range(ly.N_AUG):
+    for i in range(ly.N_STATE):
         yt[i] = y[i] + h * yt[i]
     return t + P[ly.P_RK_C + r] * h
 

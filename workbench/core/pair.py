@@ -52,8 +52,9 @@ def pair_step(t, y, h, model, ex, work, st, y_new):
     k1 = f(t, y) must be in stages[STAGE_K1]; k_i goes to stages[i - 1], the
     last (f(t + h, y_new), its contact forces in rg) to stages[s - 1].  y_new
     is projected onto the regime's constraints before the last stage (the
-    projection's size goes to st).  The error estimate h sum e_i k_i goes
-    to stages[STAGE_ERR], and each event function's smallest value over the
+    projection's size goes to st).  The error estimate h sum e_i k_i of
+    (q, q') goes to stages[STAGE_ERR] (the energy integrals are not
+    controlled), and each event function's smallest value over the
     inner stages' states to ev[EV_MIN] (the sign checks inside the step;
     EV_TRY is overwritten).
     Returns a status.
@@ -85,7 +86,7 @@ def pair_step(t, y, h, model, ex, work, st, y_new):
         return status
     err = stages[ly.STAGE_ERR]
     second = P[ly.P_RK_E3] != 0.0
-    for i in range(n):
+    for i in range(ly.N_STATE):
         acc = 0.0
         acc3 = 0.0
         for j in range(s):
