@@ -175,13 +175,14 @@ def rhs_regime(t, y, model, ex, work, ydot):
     P, tab, kc, free = model.P, model.tab, model.kc, model.free
     rec, mat, vec, cg, cw, rg = work.rec, work.mat, work.vec, work.cg, work.cw, work.rg
     set_index = int(rg[ly.RG_SET])
-    locked = False
+    det = 0.0
     if rg[ly.RG_STICK] != 0.0 and ly.SET_SECOND[set_index] >= 0 and free.shape[0] == ly.N_DOF:
         fill_geometry(y, P, cg)
-        locked = joint_locked(set_index, cg)
+        det = locking_determinant(set_index, cg)
+    locked = det != 0.0
     if locked:
         net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)
-        status = locked_joint_accelerations(y, mat, vec[ly.VEC_RHS], cg, rg, ydot)
+        status = locked_joint_accelerations(y, mat, vec[ly.VEC_RHS], cg, rg, det, ydot)
     else:
         status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
     if status != ly.OK:
@@ -202,31 +203,37 @@ def _joint_row(cg, row):
 
 
 @nb.njit(**JIT_INLINE)
-def _locked_rows(set_index):
-    """The geometry rows of a sticking double contact: both normals, the first point's tangent."""
-    return (ly.CG_G + ly.SET_FIRST[set_index], ly.CG_G + ly.SET_SECOND[set_index],
-            ly.CG_T + tangent_point(set_index))
+def _locked_rows(set_index, cg):
+    """A sticking double contact's three rows on (s, v, psi), in constraint-row order."""
+    return (_joint_row(cg, row_geometry_index(set_index, True, 0)),
+            _joint_row(cg, row_geometry_index(set_index, True, 1)),
+            _joint_row(cg, row_geometry_index(set_index, True, 2)))
+
+
+@nb.njit(**JIT_INLINE)
+def locking_determinant(set_index, cg):
+    """The determinant of a sticking double contact's 3 x 3 rows on (s, v, psi) (cg current)
+    when they lock the joint, else 0.
+
+    They lock it when the determinant exceeds LOCK_DET_REL of Hadamard's
+    bound (the product of the rows' lengths).
+    """
+    a, b, c = _locked_rows(set_index, cg)
+    bound = 1.0
+    for r in (a, b, c):
+        bound *= (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) ** 0.5
+    det = _det3(a, b, c)
+    return det if abs(det) > LOCK_DET_REL * bound else 0.0
 
 
 @nb.njit(**JIT_INLINE)
 def joint_locked(set_index, cg):
-    """Do the rows of a sticking double contact (cg current) span the joint's coordinates?
-
-    True when the determinant of the 3 x 3 rows on (s, v, psi) exceeds
-    LOCK_DET_REL of Hadamard's bound (the product of the rows' lengths).
-    """
-    g1, g2, gt = _locked_rows(set_index)
-    a = _joint_row(cg, g1)
-    b = _joint_row(cg, g2)
-    c = _joint_row(cg, gt)
-    bound = 1.0
-    for r in (a, b, c):
-        bound *= (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) ** 0.5
-    return abs(_det3(a, b, c)) > LOCK_DET_REL * bound
+    """Do the rows of a sticking double contact (cg current) lock the joint's coordinates?"""
+    return locking_determinant(set_index, cg) != 0.0
 
 
 @nb.njit(**JIT)
-def locked_joint_accelerations(y, mat, b, cg, rg, ydot):
+def locked_joint_accelerations(y, mat, b, cg, rg, det, ydot):
     """q'' and the contact forces of a sticking double contact that locks the joint.
 
     The regime's rows A (the two normals, the first point's tangent) are
@@ -235,21 +242,20 @@ def locked_joint_accelerations(y, mat, b, cg, rg, ydot):
     A q'' = -A' q' splits into blocks: A_j q_j'' = -A' q',
     M_rr q_r'' = b_r - M_rj q_j'', A_j^T lambda = M_j. q'' - b_j.  These are
     the equations of :func:`add_contact_forces`, without the solves with M
-    on the joint's rows.  M in mat[MAT_M] and b = Q - h must be y's; b's
-    beam rows are left as b_r - M_rj q_j'' and mat[MAT_CHOL] with the
-    factor of M_rr.  Writes q'' into ydot,
-    lambda (dyn) into rg and the constraint and friction powers (erg/s).
-    Returns a status code.
+    on the joint's rows.  M in mat[MAT_M] and b = Q - h must be y's, det
+    A_j's determinant (:func:`locking_determinant`); b's beam rows are left
+    as b_r - M_rj q_j'' and mat[MAT_CHOL] with the factor of M_rr.  Writes
+    q'' into ydot, lambda (dyn) into rg and the constraint and friction
+    powers (erg/s).  Returns a status code.
     """
     M = mat[ly.MAT_M]
     qd = y[ly.N_DOF:ly.N_STATE]
     qdd = ydot[ly.N_DOF:ly.N_STATE]
     set_index = int(rg[ly.RG_SET])
-    rows = _locked_rows(set_index)
-    a = _joint_row(cg, rows[0])
-    bb = _joint_row(cg, rows[1])
-    c = _joint_row(cg, rows[2])
-    inv_det = 1.0 / _det3(a, bb, c)
+    rows = (row_geometry_index(set_index, True, 0), row_geometry_index(set_index, True, 1),
+            row_geometry_index(set_index, True, 2))
+    a, bb, c = _locked_rows(set_index, cg)
+    inv_det = 1.0 / det
     conv = (-row_convective(cg, rows[0], qd), -row_convective(cg, rows[1], qd),
             -row_convective(cg, rows[2], qd))
     # the joint's accelerations by Cramer's rule on the columns of A_j
@@ -362,7 +368,8 @@ def _bound(c, d, lo, hi, short):
 @nb.njit(**JIT_INLINE)
 def _masked(cg, row, ms, mv, mp):
     """A geometry row's gradient on the free joint coordinates (s, v, psi)."""
-    return (ms * cg[row, ly.CG_DS], mv * cg[row, ly.CG_DV], mp * cg[row, ly.CG_DPSI])
+    r = _joint_row(cg, row)
+    return (ms * r[0], mv * r[1], mp * r[2])
 
 
 @nb.njit(**JIT)

@@ -176,7 +176,7 @@ def _at(free, i, rows):
     if rows == ALL_FREE:
         return i
     if rows == BEAMS_ONLY:
-        return i if i < ly.S else i + 3
+        return i if i < ly.S else i + (ly.PSI + 1 - ly.S)
     return free[i]
 
 
