@@ -25,21 +25,18 @@ import tempfile
 import time
 from pathlib import Path
 
-#: The kernels by what they do.  Inlined helpers count in their caller; stick_margin and
-#: fill_geometry serve both the right-hand side and the event functions.
+#: The kernels by what they do.  Inlined helpers count in their caller: ``rhs_regime`` holds
+#: the mass matrix, the forces and the locked joint's blocks, ``pair_step`` the event
+#: functions at its stages; fill_geometry serves both the right-hand side and the events.
 GROUPS = {
-    "right-hand side: mass matrix, h, gravity (frames and their sums)":
-        ("inertia.frame_sums", "kinematics.compute_frames", "dynamics.assemble_inertia",
-         "sin/cos (libm)"),
-    "right-hand side: applied forces, M's factor and solve":
-        ("dynamics.rhs", "dynamics.net_forces", "dynamics.add_applied_forces"),
-    "right-hand side: contact forces (constraint rows, Delassus, solve; the locked joint's blocks)":
-        ("constrained.add_contact_forces", "constrained.rhs_regime",
-         "constrained.locked_joint_accelerations",
-         "constrained.stick_margin", "contact.fill_geometry"),
-    "the pair's stage sums, estimate and dense output":
+    "right-hand side in the time loop (mass matrix, forces, the locked joint's blocks)":
+        ("constrained.rhs_regime", "sin/cos (libm)"),
+    "right-hand side elsewhere (free flight, the multipliers' contact forces)":
+        ("dynamics.rhs", "dynamics.assemble_inertia", "constrained.add_contact_forces",
+         "contact.fill_geometry"),
+    "the pair's stage sums, estimate, dense output and the event functions at its stages":
         ("pair.pair_step", "pair.dense", "pair.prepare_dense"),
-    "event functions": ("event_functions.event_values", "event_functions.event_values_after_rhs"),
+    "event functions elsewhere": ("event_functions.event_values",),
     "projection onto the regime's constraints":
         ("constrained.project", "constrained._project_rows", "constrained._project_gaps"),
     "samples (sensors, storage)": ("sensors.fill_signals", "hybrid.store", "adaptive._samples"),

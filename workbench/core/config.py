@@ -33,8 +33,11 @@ CHOLESKY_REL_PIVOT = 1e-14
 #: level, where LLVM would not inline them.  numba types and lowers an inlined
 #: helper again at every call site, so a helper that grows, or calls big ones,
 #: is a kernel of its own (``JIT``): the aggregates of the equations of motion
-#: (rhs, assemble_inertia, frame_sums, add_applied_forces, add_contact_forces,
-#: fill_geometry, ...) are compiled once and called (docs/compile.md).
+#: (rhs, assemble_inertia, add_contact_forces, fill_geometry, ...) are compiled
+#: once and called (docs/compile.md).  The exception is the right-hand side of
+#: the time loop, ``rhs_regime``: its mass matrix, forces and the locked
+#: joint's blocks are inlined into it, once (the sines 10 % faster for 20 s
+#: more of compiling, docs/compile.md).
 JIT_INLINE = dict(JIT, inline="always")
 
 #: Contact event thresholds (docs/model.md §7).  An event function must pass its

@@ -38,7 +38,7 @@ from .config import (FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, LOCK_DET_REL
                      PIVOT_REL)
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
-from .dynamics import net_forces, rhs, solve_beams, solve_factored
+from .dynamics import net_forces, solve_beams, solve_factored, solve_free
 
 
 @nb.njit(**JIT_INLINE)
@@ -180,11 +180,11 @@ def rhs_regime(t, y, model, ex, work, ydot):
         fill_geometry(y, P, cg)
         det = locking_determinant(set_index, cg)
     locked = det != 0.0
+    net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)
     if locked:
-        net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)
         status = locked_joint_accelerations(y, mat, vec[ly.VEC_RHS], cg, rg, det, ydot)
     else:
-        status = rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot)
+        status = solve_free(free, mat, vec[ly.VEC_RHS], ydot[ly.N_DOF:])
     if status != ly.OK:
         return status
     rg[ly.RG_VGRAV] = vec[ly.VEC_AUX, ly.AUX_VGRAV]
@@ -232,7 +232,7 @@ def joint_locked(set_index, cg):
     return locking_determinant(set_index, cg) != 0.0
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def locked_joint_accelerations(y, mat, b, cg, rg, det, ydot):
     """q'' and the contact forces of a sticking double contact that locks the joint.
 
@@ -372,7 +372,7 @@ def _masked(cg, row, ms, mv, mp):
     return (ms * r[0], mv * r[1], mp * r[2])
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def stick_margin(P, free, cg, rg):
     """How far a sticking regime is inside the friction cone (dyn): >= 0 while sticking holds.
 

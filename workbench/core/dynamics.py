@@ -82,8 +82,8 @@ def cork_energy(s, P):
     return spring + 0.5 * P[ly.P_K_STOP] * over * over
 
 
-@nb.njit(**JIT)
-def assemble_inertia(q, qd, P, tab, rec, mat, vec):
+@nb.njit(**JIT_INLINE)
+def inertia_terms(q, qd, P, tab, rec, mat, vec):
     """Fill M (mat[MAT_M]), h (vec[VEC_H]) and gravity (vec[VEC_Q]); return V_gravity.
 
     M (g, g cm, g cm^2 by coordinate), h = sum m J^T kappa and
@@ -108,6 +108,12 @@ def assemble_inertia(q, qd, P, tab, rec, mat, vec):
 
 
 @nb.njit(**JIT)
+def assemble_inertia(q, qd, P, tab, rec, mat, vec):
+    """:func:`inertia_terms` as a kernel of its own, for the callers off the right-hand side."""
+    return inertia_terms(q, qd, P, tab, rec, mat, vec)
+
+
+@nb.njit(**JIT_INLINE)
 def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
     """Add elastic, damping, cork, shaker and hammer forces to Q = vec[VEC_Q].
 
@@ -271,23 +277,34 @@ def solve_free(free, mat, b, x):
     return status
 
 
-@nb.njit(**JIT)
-def net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot):
-    """M (mat[MAT_M]) and b = Q - h (vec[VEC_RHS]) at y; q' into ydot[:N_DOF].
-
-    Units: dyn, dyn cm.  Leaves the scalars of vec[VEC_AUX] (gravity energy,
-    excitation power and forces).
-    """
+@nb.njit(**JIT_INLINE)
+def _add_forces(t, y, v_grav, P, tab, kc, ex, rec, vec, ydot):
+    """q' into ydot[:N_DOF], the applied forces added to the gravity in vec[VEC_Q], b = Q - h
+    into vec[VEC_RHS] and V_gravity (erg) into vec[VEC_AUX], after M, h and gravity at y."""
     q = y[:ly.N_DOF]
     qd = y[ly.N_DOF:]
     for i in range(ly.N_DOF):
         ydot[i] = qd[i]
-    vec[ly.VEC_AUX, ly.AUX_VGRAV] = assemble_inertia(q, qd, P, tab, rec, mat, vec)
+    vec[ly.VEC_AUX, ly.AUX_VGRAV] = v_grav
     add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec)
     Q = vec[ly.VEC_Q]
     b = vec[ly.VEC_RHS]
     for i in range(ly.N_DOF):
         b[i] = Q[i] - vec[ly.VEC_H, i]
+
+
+@nb.njit(**JIT_INLINE)
+def net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot):
+    """M (mat[MAT_M]) and b = Q - h (vec[VEC_RHS]) at y; q' into ydot[:N_DOF].
+
+    Units: dyn, dyn cm.  Leaves the scalars of vec[VEC_AUX] (gravity energy,
+    excitation power and forces).  Inlined whole into its caller
+    (:func:`~workbench.core.constrained.rhs_regime`, the hot path): a call
+    passes each of its arrays as a struct of pointers, shape and strides,
+    and the frames' sums are a dozen such calls deep.
+    """
+    v_grav = inertia_terms(y[:ly.N_DOF], y[ly.N_DOF:], P, tab, rec, mat, vec)
+    _add_forces(t, y, v_grav, P, tab, kc, ex, rec, vec, ydot)
 
 
 @nb.njit(**JIT)
@@ -298,7 +315,8 @@ def rhs(t, y, P, tab, kc, free, ex, rec, mat, vec, ydot):
     Leaves M's LDL^T factor in mat[MAT_CHOL] and the scalars of
     vec[VEC_AUX] (gravity energy, excitation power and forces).
     """
-    net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)
+    v_grav = assemble_inertia(y[:ly.N_DOF], y[ly.N_DOF:], P, tab, rec, mat, vec)
+    _add_forces(t, y, v_grav, P, tab, kc, ex, rec, vec, ydot)
     return solve_free(free, mat, vec[ly.VEC_RHS], ydot[ly.N_DOF:])
 
 

@@ -29,7 +29,7 @@ def event_values(y, P, free, cg, rg, ev, row, rate_row):
     _values(y, P, free, cg, rg, ev, row, rate_row)
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def event_values_after_rhs(y, P, free, cg, rg, ev, row, rate_row):
     """:func:`event_values` right after ``rhs_regime`` at y: in contact, its geometry in cg
     is y's already (``constrained.add_contact_forces`` filled it) and is not computed again."""

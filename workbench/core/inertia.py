@@ -273,10 +273,13 @@ def _add_beam(acc, P, base, q, qd, i0, omega):
 
 
 @nb.njit(**JIT_INLINE)
-def _add_frame(acc, f, u, moving, i0, n_moving, g, M, h, Q):
+def _add_frame(acc, f, u, moving, rigid, i0, n_moving, g, M, h, Q):
     """Add the accumulated points of frame record ``f`` to M, h and Q_g.
 
     ``moving`` False is the ground frame (beam A): R = I, J0 = 0, a = 0.
+    ``rigid`` True: the frame holds rigid points only (its local sums D, G
+    and D^T ell are zero and not added); else a moving frame's local columns
+    lie beyond the coordinates it moves with (i0 >= n_moving).
     ``u`` is a scratch record for the frame's rotated Jacobian rows.
     ``i0`` the first of the three local columns; the frame's origin and
     angle move with the first ``n_moving`` coordinates only (its Jacobian
@@ -316,18 +319,14 @@ def _add_frame(acc, f, u, moving, i0, n_moving, g, M, h, Q):
                 M[i, j] += vi0 * u[ly.JX + j] + vi1 * u[ly.JY + j] + vi2 * f[ly.AA + j]
             h[i] += ui0 * hx + ui1 * hy + ui2 * ha
             Q[i] += ui0 * gx + ui1 * gy + ui2 * ga
-            # U^T F and F^T U on the local columns
-            for k in range(3):
-                fk = (ui0 * acc[A_E + k] + ui1 * acc[A_E + 3 + k]
-                      + ui2 * acc[A_F3 + k])
-                c = i0 + k
-                if c > i:
-                    M[i, c] += fk
-                elif c < i:
-                    M[c, i] += fk
-                else:
-                    M[i, i] += 2.0 * fk
+            if not rigid:
+                # U^T F on the local columns, all beyond i (their F^T U below the diagonal)
+                for k in range(3):
+                    M[i, i0 + k] += (ui0 * acc[A_E + k] + ui1 * acc[A_E + 3 + k]
+                                     + ui2 * acc[A_F3 + k])
         v_grav = g * (m * f[ly.RY] + si * cx + co * cy)
+        if rigid:
+            return v_grav
         # local parts of h and gravity: E^T kappa0 + sum m D^T ell, -g (sin E_x + cos E_y)
         for k in range(3):
             h[i0 + k] += acc[A_E + k] * kx + acc[A_E + 3 + k] * ky + acc[A_DL + k]
@@ -343,7 +342,7 @@ def _add_frame(acc, f, u, moving, i0, n_moving, g, M, h, Q):
     return v_grav
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def frame_sums(q, qd, P, tab, rec, M, h, Q):
     """Add every element's M (upper triangle), h and gravity Q; return V_gravity (erg).
 
@@ -354,12 +353,13 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
     # beam A: the ground frame
     _reset(acc)
     _add_beam(acc, P, ly.P_INV_A, q, qd, ly.W_A, 0.0)
-    v_grav = _add_frame(acc, rec[ly.REC_JOINT], rec[ly.REC_U], False, ly.W_A, 0, g, M, h, Q)
+    v_grav = _add_frame(acc, rec[ly.REC_JOINT], rec[ly.REC_U], False, False, ly.W_A, 0, g, M, h,
+                        Q)
     # joint body: a rigid point of the joint frame
     fj = rec[ly.REC_JOINT]
     _reset(acc)
     _add_rigid_point(acc, P[ly.P_M3], P[ly.P_I3], P[ly.P_C3], 0.0, fj[ly.RATE])
-    v_grav += _add_frame(acc, fj, rec[ly.REC_U], True, ly.W_A, ly.U_A + 1, g, M, h, Q)
+    v_grav += _add_frame(acc, fj, rec[ly.REC_U], True, True, ly.W_A, ly.U_A + 1, g, M, h, Q)
     # loose body, beam B and the tip mass: the loose-body frame
     fl = rec[ly.REC_LOOSE]
     omega = fl[ly.RATE]
@@ -368,5 +368,5 @@ def frame_sums(q, qd, P, tab, rec, M, h, Q):
     _add_beam(acc, P, ly.P_INV_B, q, qd, ly.W_B, omega)
     _add_beam_point(acc, P[ly.P_M6], P[ly.P_I6], tab[tip_row(P, ly.R_TIP_B)], q, qd, ly.W_B,
                     P[ly.P_L4], 0.0, 1.0, omega)
-    v_grav += _add_frame(acc, fl, rec[ly.REC_U], True, ly.W_B, ly.PSI + 1, g, M, h, Q)
+    v_grav += _add_frame(acc, fl, rec[ly.REC_U], True, False, ly.W_B, ly.PSI + 1, g, M, h, Q)
     return v_grav

@@ -134,7 +134,7 @@ def tip_row(P, which):
     return 2 * int(P[ly.P_N_GAUSS]) + which
 
 
-@nb.njit(**JIT)
+@nb.njit(**JIT_INLINE)
 def compute_frames(q, qd, P, tab, rec):
     """Fill the joint-frame and loose-frame records of ``rec``."""
     # Joint frame: origin at beam A's tip; beam A's root frame is global.
