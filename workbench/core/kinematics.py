@@ -121,11 +121,42 @@ def attach(rec, frame, src, dst, rigid):
     d[ly.KY] = f[ly.KY] + s * lx + c * ly_
 
 
+#: Below this |angle| (rad) :func:`cos_sin` sums the series: its first terms left out are
+#: below 2^-67 of the sums, and the sums within an ulp of libm's (tests/core/test_kinematics.py).
+SMALL_ANGLE = 0.25
+
+
+@nb.njit(**JIT_INLINE)
+def cos_sin(angle):
+    """(cos angle, sin angle): the Taylor series to angle^14 and angle^13 (Horner) where
+    |angle| <= SMALL_ANGLE (the beams' slopes and the loose body's tilt), else libm's."""
+    if abs(angle) > SMALL_ANGLE:
+        return math.cos(angle), math.sin(angle)
+    x2 = angle * angle
+    c = 1.0 + x2 * (-1.0 / 2.0 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (
+        1.0 / 40320.0 + x2 * (-1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (
+            -1.0 / 87178291200.0)))))))
+    s = angle + angle * x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (
+        1.0 / 362880.0 + x2 * (-1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0))))))
+    return c, s
+
+
 @nb.njit(**JIT_INLINE)
 def _set_angle(rec, row, angle, rate):
-    rec[row, ly.COS] = math.cos(angle)
-    rec[row, ly.SIN] = math.sin(angle)
+    rec[row, ly.COS], rec[row, ly.SIN] = cos_sin(angle)
     rec[row, ly.RATE] = rate
+
+
+@nb.njit(**JIT_INLINE)
+def psi_trig(psi, rec):
+    """(cos psi, sin psi) of the loose body's angle psi (rad), kept in rec[REC_TRIG] for the next
+    call: psi does not change while a sticking double contact locks the joint.  An entry of
+    zeros (cos and sin both 0) is none."""
+    r = rec[ly.REC_TRIG]
+    if r[ly.TRIG_KEY] != psi or (r[ly.TRIG_COS] == 0.0 and r[ly.TRIG_SIN] == 0.0):
+        r[ly.TRIG_KEY] = psi
+        r[ly.TRIG_COS], r[ly.TRIG_SIN] = cos_sin(psi)
+    return r[ly.TRIG_COS], r[ly.TRIG_SIN]
 
 
 @nb.njit(**JIT_INLINE)
@@ -156,7 +187,13 @@ def compute_frames(q, qd, P, tab, rec):
     p[ly.JY + ly.V] = 1.0
     rec[ly.REC_JOINT, ly.AA + ly.PHI_A] = 1.0
     attach(rec, ly.REC_JOINT, ly.REC_LOCAL, ly.REC_LOOSE, False)
-    _set_angle(rec, ly.REC_LOOSE, q[ly.PHI_A] + q[ly.PSI], qd[ly.PHI_A] + qd[ly.PSI])
+    # the angle phi_A + psi: its cosine and sine by the sum's formulas
+    ca = rec[ly.REC_JOINT, ly.COS]
+    sa = rec[ly.REC_JOINT, ly.SIN]
+    cp, sp = psi_trig(q[ly.PSI], rec)
+    rec[ly.REC_LOOSE, ly.COS] = ca * cp - sa * sp
+    rec[ly.REC_LOOSE, ly.SIN] = sa * cp + ca * sp
+    rec[ly.REC_LOOSE, ly.RATE] = qd[ly.PHI_A] + qd[ly.PSI]
     for j in range(ly.N_DOF):
         rec[ly.REC_LOOSE, ly.AA + j] = 0.0
     rec[ly.REC_LOOSE, ly.AA + ly.PHI_A] = 1.0

@@ -11,7 +11,6 @@ sample's state, whose frames, mass matrix, contact forces and q'' it reads.
 
 Accelerations are J q'' + kappa of the sensor point (cm/s^2).
 """
-import math
 
 import numba as nb
 
@@ -20,7 +19,7 @@ from . import layout as ly
 from .constrained import kinetic_energy
 from .contact import fill_geometry, regime_of
 from .dynamics import cork_energy
-from .kinematics import beam_b_point, rigid_point, tip_row
+from .kinematics import beam_b_point, cos_sin, rigid_point, tip_row
 
 
 @nb.njit(**JIT_INLINE)
@@ -61,7 +60,8 @@ def fill_signals(y, ydot, P, tab, kc, rec, mat, vec, cg, rg, st, out):
     row = tab[tip_row(P, ly.R_ACCEL3)]
     beam_b_point(row, q, qd, P, rec, ly.REC_POINT)
     angle = q[ly.PHI_A] + q[ly.PSI] + row[ly.T_DN1] * q[ly.W_B] + row[ly.T_DN2] * q[ly.PHI_B]
-    out[ly.SIG_ACCEL3] = _local_y_accel(rec, qdd, math.cos(angle), math.sin(angle))
+    ca, sa = cos_sin(angle)
+    out[ly.SIG_ACCEL3] = _local_y_accel(rec, qdd, ca, sa)
     beam_b_point(tab[tip_row(P, ly.R_TIP_B)], q, qd, P, rec, ly.REC_POINT)
     out[ly.SIG_TIP_Y] = rec[ly.REC_POINT, ly.RY]
     fill_geometry(y, P, cg)
