@@ -36,8 +36,8 @@ CHOLESKY_REL_PIVOT = 1e-14
 #: (rhs, assemble_inertia, add_contact_forces, fill_geometry, ...) are compiled
 #: once and called (docs/compile.md).  The exception is the right-hand side of
 #: the time loop, ``rhs_regime``: its mass matrix, forces and the locked
-#: joint's blocks are inlined into it, once (the sines 10 % faster for 20 s
-#: more of compiling, docs/compile.md).
+#: joint's blocks are inlined into it, once (the sines 10 % faster for 12 s
+#: more of ``workbench compile`` on 2 cores, docs/compile.md).
 JIT_INLINE = dict(JIT, inline="always")
 
 #: Contact event thresholds (docs/model.md §7).  An event function must pass its
