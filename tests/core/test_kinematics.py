@@ -12,7 +12,7 @@ from conftest import random_state
 
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
-from workbench.core.kinematics import SMALL_ANGLE, cos_sin, element_kinematics, psi_trig
+from workbench.core.kinematics import SMALL_ANGLE, cos_sin, element_kinematics
 from workbench.core.shapes import fill_shape_row
 from workbench.model.params import Parameters
 
@@ -108,13 +108,6 @@ def _cos_sin_all(x, c, s):
         c[i], s[i] = cos_sin(x[i])
 
 
-@nb.njit
-def _psi_trig_calls(psis, rec, out):
-    for i in range(psis.size):
-        out[i, 0], out[i, 1] = psi_trig(psis[i], rec)
-        out[i, 2] = rec[ly.REC_TRIG, ly.TRIG_KEY]
-
-
 def test_small_angle_cosine_and_sine_within_an_ulp_of_libm():
     rng = np.random.default_rng(3)
     tiny = np.geomspace(1e-300, SMALL_ANGLE, 2000)
@@ -129,18 +122,3 @@ def test_small_angle_cosine_and_sine_within_an_ulp_of_libm():
     assert big.sum() == 5 and np.array_equal(c[big], np.cos(x[big]))
     assert np.array_equal(s[big], np.sin(x[big]))
     assert (c == np.cos(x)).mean() > 0.98 and (s == np.sin(x)).mean() > 0.98
-
-
-def test_psi_trig_keeps_the_last_angle_and_takes_a_row_of_zeros_for_none():
-    rec = mdl.make_work().rec                           # zeros: psi = 0 must not read (0, 0)
-    psis = np.array([0.0, 0.0, 0.01, 0.01, -0.02, 0.0])
-    out = np.zeros((psis.size, 3))
-    _psi_trig_calls(psis, rec, out)
-    want_c, want_s = np.empty_like(psis), np.empty_like(psis)
-    _cos_sin_all(psis, want_c, want_s)
-    assert np.array_equal(out[:, 0], want_c) and np.array_equal(out[:, 1], want_s)
-    assert out[0, 0] == 1.0 and out[0, 1] == 0.0
-    assert np.array_equal(out[:, 2], psis)
-    rec[ly.REC_TRIG, ly.TRIG_COS] = 7.0                 # a kept value is returned as kept
-    _psi_trig_calls(psis[-1:], rec, out)
-    assert out[0, 0] == 7.0

@@ -37,9 +37,8 @@ import numpy as np
 from .config import (FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, LOCK_DET_REL, NULL_COFACTOR_REL,
                      PIVOT_REL)
 from . import layout as ly
-from .contact import fill_geometry, geometry_at, in_set, row_convective, row_rate, row_to_dof
+from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
 from .dynamics import net_forces, solve_beams, solve_factored, solve_free
-from .kinematics import psi_trig
 
 
 @nb.njit(**JIT_INLINE)
@@ -178,8 +177,7 @@ def rhs_regime(t, y, model, ex, work, ydot):
     set_index = int(rg[ly.RG_SET])
     det = 0.0
     if rg[ly.RG_STICK] != 0.0 and ly.SET_SECOND[set_index] >= 0 and free.shape[0] == ly.N_DOF:
-        c, sn = psi_trig(y[ly.PSI], rec)
-        geometry_at(y, c, sn, P, cg)
+        fill_geometry(y, P, cg)
         det = locking_determinant(set_index, cg)
     locked = det != 0.0
     net_forces(t, y, P, tab, kc, ex, rec, mat, vec, ydot)

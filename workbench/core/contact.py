@@ -49,15 +49,9 @@ def _put(cg, row, val, ds, dv, dp, hss, hsv, hsp, hvv, hvp, hpp):
 @nb.njit(**JIT)
 def fill_geometry(q, P, cg):
     """Gaps g1..g4 and tangents tau1..tau4 with derivatives (cm, cm/rad, ...) into cg."""
-    c, sn = cos_sin(q[ly.PSI])
-    geometry_at(q, c, sn, P, cg)
-
-
-@nb.njit(**JIT_INLINE)
-def geometry_at(q, c, sn, P, cg):
-    """:func:`fill_geometry` with c = cos psi and sn = sin psi given."""
     s = q[ly.S]
     v = q[ly.V]
+    c, sn = cos_sin(q[ly.PSI])
     a = 0.5 * P[ly.P_H4]                      # h4 / 2
     half_gap = 0.5 * P[ly.P_GAP]
     H = a + half_gap

@@ -148,18 +148,6 @@ def _set_angle(rec, row, angle, rate):
 
 
 @nb.njit(**JIT_INLINE)
-def psi_trig(psi, rec):
-    """(cos psi, sin psi) of the loose body's angle psi (rad), kept in rec[REC_TRIG] for the next
-    call: psi does not change while a sticking double contact locks the joint.  An entry of
-    zeros (cos and sin both 0) is none."""
-    r = rec[ly.REC_TRIG]
-    if r[ly.TRIG_KEY] != psi or (r[ly.TRIG_COS] == 0.0 and r[ly.TRIG_SIN] == 0.0):
-        r[ly.TRIG_KEY] = psi
-        r[ly.TRIG_COS], r[ly.TRIG_SIN] = cos_sin(psi)
-    return r[ly.TRIG_COS], r[ly.TRIG_SIN]
-
-
-@nb.njit(**JIT_INLINE)
 def tip_row(P, which):
     """Row of the shape table holding special point ``which`` (an R_* index)."""
     return 2 * int(P[ly.P_N_GAUSS]) + which
@@ -187,13 +175,7 @@ def compute_frames(q, qd, P, tab, rec):
     p[ly.JY + ly.V] = 1.0
     rec[ly.REC_JOINT, ly.AA + ly.PHI_A] = 1.0
     attach(rec, ly.REC_JOINT, ly.REC_LOCAL, ly.REC_LOOSE, False)
-    # the angle phi_A + psi: its cosine and sine by the sum's formulas
-    ca = rec[ly.REC_JOINT, ly.COS]
-    sa = rec[ly.REC_JOINT, ly.SIN]
-    cp, sp = psi_trig(q[ly.PSI], rec)
-    rec[ly.REC_LOOSE, ly.COS] = ca * cp - sa * sp
-    rec[ly.REC_LOOSE, ly.SIN] = sa * cp + ca * sp
-    rec[ly.REC_LOOSE, ly.RATE] = qd[ly.PHI_A] + qd[ly.PSI]
+    _set_angle(rec, ly.REC_LOOSE, q[ly.PHI_A] + q[ly.PSI], qd[ly.PHI_A] + qd[ly.PSI])
     for j in range(ly.N_DOF):
         rec[ly.REC_LOOSE, ly.AA + j] = 0.0
     rec[ly.REC_LOOSE, ly.AA + ly.PHI_A] = 1.0

@@ -208,9 +208,7 @@ REC_LOCAL = 2    # a point in a frame, before it is carried to global
 REC_POINT = 3    # the current point, global
 REC_ACC = 4      # sums over a frame's points (workbench.core.inertia)
 REC_U = 5        # a frame's Jacobian rows in its own axes, JX/JY columns (workbench.core.inertia)
-REC_TRIG = 6     # the last psi's (TRIG_KEY) cosine and sine (kinematics.psi_trig)
-N_RECS = 7
-TRIG_KEY, TRIG_COS, TRIG_SIN = 0, 1, 2
+N_RECS = 6
 
 # --- work matrices and vectors -----------------------------------------------
 KC_K, KC_C = 0, 1                # kc (2, 9, 9): stiffness, damping
