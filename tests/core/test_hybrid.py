@@ -244,9 +244,12 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     what the gap changes in EVENT_TIME_TOL (``adaptive._step_past``; at the
     default tolerance this case's deepest is 1.5 times, 2.4e-9 cm at at most
     160 cm/s; the old projection's 9.06e-9 cm was 8 times).  Moreau's law
-    with e = 0 loses at least u_n P_n / 2 of kinetic energy, so the closing
-    speed of the impact with the deepest penetration is at most
-    2 ke_lost / sum P_n.
+    with e = 0 takes u_n P_n / 2 of kinetic energy at each point, and its
+    friction adds to that point's loss, so the impacting point's closing
+    speed is at most 2 ke_lost_p / P_n,p.  (2 ke_lost / sum P_n is the
+    impulses' mean of the points' closing speeds: a second point of the
+    impact closed with it lowers it, 88.7 cm/s against the impacting point's
+    149 cm/s at the deepest impact from 0.7518 s at b5bffd4.)
     """
     p = Parameters(cork="quadratic").replace(gap_mm=1.016)
     run = simulate(p, drives.sine(200.0, 45.0, ramp_s=1.0), 2.2)
@@ -256,8 +259,8 @@ def test_a_point_released_by_the_regime_choice_leaves_from_contact():
     deepest = ev.iloc[int(np.argmin(np.abs(ev.t - run.stats["t_max_penetration"])))]
     assert deepest.kind == "impact"
     assert deepest.t == pytest.approx(run.stats["t_max_penetration"], abs=1e-12)
-    impulse = sum(deepest[f"impulse_n{k}"] for k in range(1, 5))
-    closing_speed = 2.0 * deepest.ke_lost / impulse                # cm/s, an upper bound
+    p = int(deepest.point)
+    closing_speed = 2.0 * deepest[f"ke_lost{p}"] / deepest[f"impulse_n{p}"]   # cm/s, a bound
     assert 0.0 < run.stats["max_penetration_cm"] < 2.0 * closing_speed * EVENT_TIME_TOL + GAP_EPS
 
 
