@@ -18,8 +18,9 @@ written to ``floor_log``.
 
 Events are looked for in each accepted step (:func:`workbench.core.hybrid.locate`
 on the dense output): a sign change between the step's ends, or an event
-function negative at one of the step's stages or, for a gap turning within
-the step, at its Hermite minimum, is checked on the dense output and
+function negative at one of the step's stages (by more than its error in the
+step, DIP_NOISE_FLOOR_REL) or, for a gap turning within the step, at its
+Hermite minimum, is checked on the dense output and
 located there by Brent's method to EVENT_TIME_TOL; then one step of the
 pair from the step's start to the event, moved on by short steps
 (SHORT_STEP_S) to within EVENT_TIME_TOL of it, gives the state there, the event
@@ -34,8 +35,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP,
-                     SHORT_STEP_S, STEP_REMAINDER_REL, STEPPED_TIME_S)
+from .config import (DIP_NOISE_FLOOR_REL, EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE,
+                     MAX_EVENTS_PER_STEP, SHORT_STEP_S, STEP_REMAINDER_REL, STEPPED_TIME_S)
 from . import layout as ly
 from .constrained import rhs_regime
 from .contact import regime_of
@@ -302,19 +303,17 @@ def _rejected(status, err, arg, h, h_floor, order, ctl):
 
 
 @nb.njit(**JIT)
-def _accepted(step, force, tol, before, model, work, control):
+def _accepted(step, force, before, work, control):
     """The account of an accepted step ``step`` = (t, h, err, arg, dt, e, theta): its
-    statistics, the error scales grown by its state and total normal force (dyn), the
-    event functions' noise levels, and the squared time error of its event e (if any);
-    ``before`` is the regime's (set, stick) before the step."""
+    statistics, the error scales grown by its state and total normal force (dyn), and the
+    squared time error of its event e (if any); ``before`` is the regime's (set, stick)
+    before the step."""
     t, h, err, arg, dt, e, theta = step
-    P, stages, rg, ev = model.P, work.stages, work.rg, work.ev
+    stages, rg, ev = work.stages, work.rg, work.ev
     ctl, scale, floor_log = control
     ctl[ly.CTL_WORK] += 1.0
     _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, before[0], before[1])
     grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
-    for k in range(ly.N_EV):
-        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
     if e >= 0:
         te = _event_time_error(e, theta * h, ev, stages[ly.STAGE_TMP])
         ctl[ly.CTL_T_SSQ] += te * te
@@ -345,6 +344,8 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
         ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
         for k in range(ly.N_EV):
             ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
+            bound = tol * event_scale(k, P, scale, ctl)
+            ev[ly.EV_NOISE, k] = min(bound, max(ev_err[k], DIP_NOISE_FLOOR_REL * bound))
         status, e, theta = locate(t, h_try, np.bool_(True), model, ex, work)
         if status == ly.OK and e >= 0:
             te = _event_time_error(e, theta * h_try, ev, ev_err)
@@ -471,8 +472,6 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     last = int(P[ly.P_RK_STAGES]) - 1
     floors(P, scale)
     grow_scales(y, total_normal_force(rg), scale, ctl)
-    for k in range(ly.N_EV):
-        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
     h_floor = dt / (1 << level_max)
     h_max = max(P[ly.P_RK_STEP_FACTOR], 1.0) * dt
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
@@ -512,8 +511,8 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         if status != ly.OK:
             st[ly.ST_T] = t
             return status, stored, n_log
-        _accepted((t, h_try, err, arg, dt, e, theta), force, tol, (set_before, stick_before),
-                  model, work, control)
+        _accepted((t, h_try, err, arg, dt, e, theta), force, (set_before, stick_before), work,
+                  control)
         t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
         if e < 0 and h_try == t_stop - t:
             t_end = t_stop
