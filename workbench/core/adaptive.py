@@ -192,7 +192,10 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     the bracket is EVENT_TIME_TOL wide.  A move of at most SHORT_STEP_S from
     the last step of the pair is a short step from its state
     (:func:`_short_step`).  Returns ``(status, theta)``; the events at the
-    state in EV_HI.
+    state in EV_HI.  theta is -1 when the pair's states do not pass the event
+    up to the step's end, where it is positive: a dip of the dense output
+    inside the step, within the two approximations' difference, that is
+    no event.  Steps of the pair overwrite the step's stages.
     """
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
@@ -210,6 +213,8 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     last = int(P[ly.P_RK_STAGES]) - 1
     for _ in range(PAST_ITERS):
         if x >= 1.0:
+            if hi > 1.0 and ev[ly.EV_END, e] >= 0.0:
+                return ly.OK, -1.0
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
@@ -384,12 +389,34 @@ def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
 
 
 @nb.njit(**JIT)
+def _retake(t, h, t_stop, y, lattice, counts, model, ex, work, st, out):
+    """The accepted step of h (s) from (t, y) again, after the steps of the pair towards an
+    event it did not pass: its stages, end (STAGE_NEXT, its events in EV_END) and dense
+    output as before (the same arithmetic), and its samples not yet stored.  Returns
+    (status, stored, b_next)."""
+    P, free = model.P, model.free
+    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    status = pair_step(t, y, h, model, ex, work, st, stages[ly.STAGE_NEXT])
+    if status == ly.OK and P[ly.P_RK_EXTRA] > 0.0:
+        status = prepare_dense(t, y, h, model, ex, work)
+    if status != ly.OK:
+        return status, counts[0], counts[1]
+    event_values_after_rhs(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
+    t_end = t_stop if h == t_stop - t else t + h
+    return _samples(t, t_end, h, np.bool_(True), y, lattice, counts, model, ex, work, st, out)
+
+
+@nb.njit(**JIT)
 def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
     """After a step of h (s) from (t, y) in which event e was located at theta: one step of
     the pair from the step's start to just past it, then the event and any impact it sets
-    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log)."""
+    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log); t is -1
+    when the pair's states do not pass the event (:func:`_step_past`: no event, the step's
+    stages overwritten)."""
     stages, rg, ev = work.stages, work.rg, work.ev
     status, theta = _step_past(e, theta, t, h, model, ex, work, st)
+    if status == ly.OK and theta < 0.0:
+        return ly.OK, -1.0, n_log
     if status == ly.OK:
         status, e, theta = _earlier_on_steps(e, theta, t, h, model, ex, work)
     if status != ly.OK:
@@ -521,14 +548,22 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
                                           (stored, b_next), model, ex, work, st, out)
         if status != ly.OK:
             return status, stored, n_log
+        if e >= 0:
+            status, t_event, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work,
+                                               log, n_log, st)
+            if status == ly.OK and t_event < 0.0:
+                # no event after all: the step again, whole, and the rest of its samples
+                lattice = (t0, step0, dt, decim, m_stop)
+                status, stored, b_next = _retake(t, h_try, t_stop, y, lattice, (stored, b_next),
+                                                 model, ex, work, st, out)
+                e = -1
+                t_end = t_stop if h_try == t_stop - t else t + h_try
+            if status != ly.OK:
+                return status, stored, n_log
+            t = t_event
         if e < 0:
             _take_step(stages, ev, last)
             t = t_end
-        else:
-            status, t, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work, log,
-                                         n_log, st)
-            if status != ly.OK:
-                return status, stored, n_log
         if err <= 1.0:                       # no growth right after a rejection
             h = min(_next_step(h_try, err, err_prev, order), h_try if rejected else np.inf)
             err_prev = max(err, ERR_PREV_START)
