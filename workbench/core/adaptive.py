@@ -389,11 +389,11 @@ def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
 
 
 @nb.njit(**JIT)
-def _retake(t, h, t_stop, y, lattice, counts, model, ex, work, st, out):
+def _retake(t, h, t_end, y, lattice, counts, model, ex, work, st, out):
     """The accepted step of h (s) from (t, y) again, after the steps of the pair towards an
     event it did not pass: its stages, end (STAGE_NEXT, its events in EV_END) and dense
-    output as before (the same arithmetic), and its samples not yet stored.  Returns
-    (status, stored, b_next)."""
+    output as before (the same arithmetic), and its samples not yet stored up to t_end (its
+    end).  Returns (status, stored, b_next)."""
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
     status = pair_step(t, y, h, model, ex, work, st, stages[ly.STAGE_NEXT])
@@ -402,7 +402,6 @@ def _retake(t, h, t_stop, y, lattice, counts, model, ex, work, st, out):
     if status != ly.OK:
         return status, counts[0], counts[1]
     event_values_after_rhs(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-    t_end = t_stop if h == t_stop - t else t + h
     return _samples(t, t_end, h, np.bool_(True), y, lattice, counts, model, ex, work, st, out)
 
 
@@ -527,8 +526,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
                 return status, stored, n_log
             continue
         h_try = min(h, h_max, t_stop - t)
-        set_before = int(rg[ly.RG_SET])
-        stick_before = rg[ly.RG_STICK] != 0.0
+        before = (int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)     # the regime before the step
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
@@ -538,26 +536,22 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         if status != ly.OK:
             st[ly.ST_T] = t
             return status, stored, n_log
-        _accepted((t, h_try, err, arg, dt, e, theta), force, (set_before, stick_before), work,
-                  control)
-        t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
-        if e < 0 and h_try == t_stop - t:
-            t_end = t_stop
+        _accepted((t, h_try, err, arg, dt, e, theta), force, before, work, control)
+        t_whole = t_stop if h_try == t_stop - t else t + h_try
+        t_end = t_whole if e < 0 else t + min(theta, 1.0) * h_try
         # samples in (t, t_end]: the dense output of this step (or its end)
-        status, stored, b_next = _samples(t, t_end, h_try, e < 0, y, (t0, step0, dt, decim, m_stop),
-                                          (stored, b_next), model, ex, work, st, out)
+        lattice = (t0, step0, dt, decim, m_stop)
+        status, stored, b_next = _samples(t, t_end, h_try, e < 0, y, lattice, (stored, b_next),
+                                          model, ex, work, st, out)
         if status != ly.OK:
             return status, stored, n_log
         if e >= 0:
             status, t_event, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work,
                                                log, n_log, st)
-            if status == ly.OK and t_event < 0.0:
-                # no event after all: the step again, whole, and the rest of its samples
-                lattice = (t0, step0, dt, decim, m_stop)
-                status, stored, b_next = _retake(t, h_try, t_stop, y, lattice, (stored, b_next),
+            if status == ly.OK and t_event < 0.0:   # no event after all: the step whole
+                status, stored, b_next = _retake(t, h_try, t_whole, y, lattice, (stored, b_next),
                                                  model, ex, work, st, out)
-                e = -1
-                t_end = t_stop if h_try == t_stop - t else t + h_try
+                e, t_end = -1, t_whole
             if status != ly.OK:
                 return status, stored, n_log
             t = t_event
