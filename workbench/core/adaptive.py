@@ -18,9 +18,8 @@ written to ``floor_log``.
 
 Events are looked for in each accepted step (:func:`workbench.core.hybrid.locate`
 on the dense output): a sign change between the step's ends, or an event
-function negative at one of the step's stages (by more than its error in the
-step, DIP_NOISE_FLOOR_REL) or, for a gap turning within the step, at its
-Hermite minimum, is checked on the dense output and
+function negative at one of the step's stages or, for a gap turning within
+the step, at its Hermite minimum, is checked on the dense output and
 located there by Brent's method to EVENT_TIME_TOL; then one step of the
 pair from the step's start to the event, moved on by short steps
 (SHORT_STEP_S) to within EVENT_TIME_TOL of it, gives the state there, the event
@@ -35,8 +34,8 @@ import math
 import numba as nb
 import numpy as np
 
-from .config import (DIP_NOISE_FLOOR_REL, EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE,
-                     MAX_EVENTS_PER_STEP, SHORT_STEP_S, STEP_REMAINDER_REL, STEPPED_TIME_S)
+from .config import (EVENT_TIME_SCALE_S, EVENT_TIME_TOL, JIT, JIT_INLINE, MAX_EVENTS_PER_STEP,
+                     SHORT_STEP_S, STEP_REMAINDER_REL, STEPPED_TIME_S)
 from . import layout as ly
 from .constrained import rhs_regime
 from .contact import regime_of
@@ -192,10 +191,7 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     the bracket is EVENT_TIME_TOL wide.  A move of at most SHORT_STEP_S from
     the last step of the pair is a short step from its state
     (:func:`_short_step`).  Returns ``(status, theta)``; the events at the
-    state in EV_HI.  theta is -1 when the pair's states do not pass the event
-    up to the step's end, where it is positive: a dip of the dense output
-    inside the step, within the two approximations' difference, that is
-    no event.  Steps of the pair overwrite the step's stages.
+    state in EV_HI.
     """
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
@@ -213,8 +209,6 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     last = int(P[ly.P_RK_STAGES]) - 1
     for _ in range(PAST_ITERS):
         if x >= 1.0:
-            if hi > 1.0 and ev[ly.EV_END, e] >= 0.0:
-                return ly.OK, -1.0
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
@@ -308,17 +302,19 @@ def _rejected(status, err, arg, h, h_floor, order, ctl):
 
 
 @nb.njit(**JIT)
-def _accepted(step, force, before, work, control):
+def _accepted(step, force, tol, before, model, work, control):
     """The account of an accepted step ``step`` = (t, h, err, arg, dt, e, theta): its
-    statistics, the error scales grown by its state and total normal force (dyn), and the
-    squared time error of its event e (if any); ``before`` is the regime's (set, stick)
-    before the step."""
+    statistics, the error scales grown by its state and total normal force (dyn), the
+    event functions' noise levels, and the squared time error of its event e (if any);
+    ``before`` is the regime's (set, stick) before the step."""
     t, h, err, arg, dt, e, theta = step
-    stages, rg, ev = work.stages, work.rg, work.ev
+    P, stages, rg, ev = model.P, work.stages, work.rg, work.ev
     ctl, scale, floor_log = control
     ctl[ly.CTL_WORK] += 1.0
     _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, before[0], before[1])
     grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
+    for k in range(ly.N_EV):
+        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
     if e >= 0:
         te = _event_time_error(e, theta * h, ev, stages[ly.STAGE_TMP])
         ctl[ly.CTL_T_SSQ] += te * te
@@ -349,8 +345,6 @@ def _try_step(t, y, h_try, tol, h_floor, model, ex, work, st, scale, ctl):
         ev_err = stages[ly.STAGE_TMP]       # the event functions' estimates
         for k in range(ly.N_EV):
             ev_err[k] = abs(ev[ly.EV_END, k] - ev[ly.EV_TRY, k])
-            bound = tol * event_scale(k, P, scale, ctl)
-            ev[ly.EV_NOISE, k] = min(bound, max(ev_err[k], DIP_NOISE_FLOOR_REL * bound))
         status, e, theta = locate(t, h_try, np.bool_(True), model, ex, work)
         if status == ly.OK and e >= 0:
             te = _event_time_error(e, theta * h_try, ev, ev_err)
@@ -389,33 +383,12 @@ def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
 
 
 @nb.njit(**JIT)
-def _retake(t, h, t_end, y, lattice, counts, model, ex, work, st, out):
-    """The accepted step of h (s) from (t, y) again, after the steps of the pair towards an
-    event it did not pass: its stages, end (STAGE_NEXT, its events in EV_END) and dense
-    output as before (the same arithmetic), and its samples not yet stored up to t_end (its
-    end).  Returns (status, stored, b_next)."""
-    P, free = model.P, model.free
-    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
-    status = pair_step(t, y, h, model, ex, work, st, stages[ly.STAGE_NEXT])
-    if status == ly.OK and P[ly.P_RK_EXTRA] > 0.0:
-        status = prepare_dense(t, y, h, model, ex, work)
-    if status != ly.OK:
-        return status, counts[0], counts[1]
-    event_values_after_rhs(stages[ly.STAGE_NEXT], P, free, cg, rg, ev, ly.EV_END, ly.EV_RATE_END)
-    return _samples(t, t_end, h, np.bool_(True), y, lattice, counts, model, ex, work, st, out)
-
-
-@nb.njit(**JIT)
 def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
     """After a step of h (s) from (t, y) in which event e was located at theta: one step of
     the pair from the step's start to just past it, then the event and any impact it sets
-    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log); t is -1
-    when the pair's states do not pass the event (:func:`_step_past`: no event, the step's
-    stages overwritten)."""
+    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log)."""
     stages, rg, ev = work.stages, work.rg, work.ev
     status, theta = _step_past(e, theta, t, h, model, ex, work, st)
-    if status == ly.OK and theta < 0.0:
-        return ly.OK, -1.0, n_log
     if status == ly.OK:
         status, e, theta = _earlier_on_steps(e, theta, t, h, model, ex, work)
     if status != ly.OK:
@@ -498,6 +471,8 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     last = int(P[ly.P_RK_STAGES]) - 1
     floors(P, scale)
     grow_scales(y, total_normal_force(rg), scale, ctl)
+    for k in range(ly.N_EV):
+        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
     h_floor = dt / (1 << level_max)
     h_max = max(P[ly.P_RK_STEP_FACTOR], 1.0) * dt
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
@@ -526,7 +501,8 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
                 return status, stored, n_log
             continue
         h_try = min(h, h_max, t_stop - t)
-        before = (int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)     # the regime before the step
+        set_before = int(rg[ly.RG_SET])
+        stick_before = rg[ly.RG_STICK] != 0.0
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
@@ -536,28 +512,24 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         if status != ly.OK:
             st[ly.ST_T] = t
             return status, stored, n_log
-        _accepted((t, h_try, err, arg, dt, e, theta), force, before, work, control)
-        t_whole = t_stop if h_try == t_stop - t else t + h_try
-        t_end = t_whole if e < 0 else t + min(theta, 1.0) * h_try
+        _accepted((t, h_try, err, arg, dt, e, theta), force, tol, (set_before, stick_before),
+                  model, work, control)
+        t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
+        if e < 0 and h_try == t_stop - t:
+            t_end = t_stop
         # samples in (t, t_end]: the dense output of this step (or its end)
-        lattice = (t0, step0, dt, decim, m_stop)
-        status, stored, b_next = _samples(t, t_end, h_try, e < 0, y, lattice, (stored, b_next),
-                                          model, ex, work, st, out)
+        status, stored, b_next = _samples(t, t_end, h_try, e < 0, y, (t0, step0, dt, decim, m_stop),
+                                          (stored, b_next), model, ex, work, st, out)
         if status != ly.OK:
             return status, stored, n_log
-        if e >= 0:
-            status, t_event, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work,
-                                               log, n_log, st)
-            if status == ly.OK and t_event < 0.0:   # no event after all: the step whole
-                status, stored, b_next = _retake(t, h_try, t_whole, y, lattice, (stored, b_next),
-                                                 model, ex, work, st, out)
-                e, t_end = -1, t_whole
-            if status != ly.OK:
-                return status, stored, n_log
-            t = t_event
         if e < 0:
             _take_step(stages, ev, last)
             t = t_end
+        else:
+            status, t, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work, log,
+                                         n_log, st)
+            if status != ly.OK:
+                return status, stored, n_log
         if err <= 1.0:                       # no growth right after a rejection
             h = min(_next_step(h_try, err, err_prev, order), h_try if rejected else np.inf)
             err_prev = max(err, ERR_PREV_START)

@@ -166,13 +166,6 @@ LOCK_DET_REL = 1e-6
 #: event function's estimate over its rate) within tol times it, as the time
 #: of one sample of the default 1 kHz record.
 EVENT_TIME_SCALE_S = 1e-3
-#: A dip of an event function inside a step (positive at both ends, negative at a
-#: stage) counts when it is below minus the function's error in that step: the
-#: step's own estimate of it (its value at the propagated less at the embedded
-#: solution), not above its bound tol times its scale and not below this fraction of
-#: that bound.  With the bound alone, the slip rate's dips of brief stick phases
-#: (1-30 us; about 1e-4 of its scale deep) were taken as noise and their events lost.
-DIP_NOISE_FLOOR_REL = 1e-3
 #: Floors of the error scales: the clearance (cm) for positions (over a
 #: length for angles), and that times REF_RATE (1/s) for velocities.
 REF_RATE = 100.0

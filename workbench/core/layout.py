@@ -303,9 +303,8 @@ N_CW_COLS = N_LAW_COLS
 # Rows: values at the step's start, end, a trial point, the earliest point
 # found past an event (HI); gap rates at the start, end and trial point;
 # (EV_MIN) the smallest value of each event function over a step's stages;
-# (EV_NOISE) the error each function carries in the step (a dip inside a step
-# counts only below minus it; config.DIP_NOISE_FLOOR_REL; zeros for the
-# fixed-step method).
+# (EV_NOISE) the error each function may carry (a dip inside a step counts
+# only below minus it; zeros for the fixed-step method).
 EV_START, EV_END, EV_TRY, EV_HI, EV_RATE_START, EV_RATE_END, EV_RATE_TRY, EV_MIN, EV_NOISE = range(9)
 N_EV_ROWS = 9
 EV_GAP = 0                   # EV_GAP + k: open gap g_k (impact); rates hold g_k'

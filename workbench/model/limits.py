@@ -15,9 +15,10 @@ MAX_DT = 1e-3
 #: (docs/model.md "Integration").  The default is the largest of 1e-4, 5e-5,
 #: 3e-5, 2e-5 and 1e-5 at which the default method (dop853) keeps all 22
 #: converged windows of benchmarks/controlled_accuracy.py within the bounds
-#: (tip 1e-3 of its range, shares 1e-3, events 5 %; 1e-4 and 5e-5 keep them too)
-#: and every event of the tests' 36 ms reference case within 1e-6 s (7.9e-7 s;
-#: 1.02e-6 s at 5e-5, 2.2e-6 s at 1e-4); docs/performance.md "Accuracy against cost".
+#: (tip 1e-3 of its range, shares 1e-3, events 5 %; at 1e-4 two windows' events
+#: are 5.1 and 5.5 % off) and every event of the tests' 36 ms reference case
+#: within 1e-6 s (7.9e-7 s; at 5e-5 it takes 32 of the 34 events);
+#: docs/performance.md "Accuracy against cost".
 DEFAULT_TOL = 3e-5
 TOL_RANGE = (1e-9, 1e-1)
 #: The largest sample rate of the stored signals (Hz).
