@@ -12,7 +12,8 @@ from conftest import random_state
 
 from workbench.model import packing as mdl
 from workbench.core import layout as ly
-from workbench.core.constrained import add_contact_forces, joint_locked, rhs_regime
+from workbench.core.config import TINY_STATE
+from workbench.core.constrained import add_contact_forces, joint_locked, project, rhs_regime
 from workbench.core.contact import eval_geometry, row_convective
 from workbench.core.dynamics import rhs
 from workbench.model.drives import sine
@@ -100,3 +101,29 @@ def test_held_coordinates_take_the_multiplier_solution():
         fast, rg_fast, slow, rg_slow = _both_ways(y, model, work, ex, set_index)
         assert np.array_equal(fast[:ly.N_STATE], slow[:ly.N_STATE])
         assert np.array_equal(rg_fast, rg_slow)
+
+
+def test_the_projection_sets_the_state_s_tiny_components_to_zero():
+    """A locked joint's rates are zero in exact arithmetic; their round-off must not be left to
+    decay into the subnormal doubles (config.TINY_STATE): a projection onto a sticking double
+    contact sets every component of (q, q') below TINY_STATE to zero, and gives the same state
+    as from those components at zero."""
+    model, work = mdl.build(Parameters()), mdl.make_work()
+    y = np.zeros(ly.N_AUG)
+    y[:ly.N_STATE] = random_state(np.random.default_rng(11))
+    rg = work.rg
+    rg[:] = 0.0
+    rg[ly.RG_SET], rg[ly.RG_STICK], rg[ly.RG_SIGN] = 5, 1.0, 1.0
+    project(y, model.P, model.free, work.cg, work.cw, rg, np.bool_(False))
+    tiny = {ly.N_DOF + ly.V: 5e-323, ly.N_DOF + ly.PSI: -2e-310, ly.N_DOF + ly.W_B: -3e-200,
+            ly.U_A: 1e-160}
+    for i in tiny:
+        y[i] = 0.0
+    at_zero = y.copy()
+    for i, value in tiny.items():
+        y[i] = value
+    assert all(abs(v) < TINY_STATE for v in tiny.values())
+    project(at_zero, model.P, model.free, work.cg, work.cw, rg, np.bool_(False))
+    project(y, model.P, model.free, work.cg, work.cw, rg, np.bool_(False))
+    assert all(y[i] == 0.0 for i in tiny)
+    assert np.array_equal(y, at_zero)

@@ -28,6 +28,18 @@ JIT_ALLOC = dict(JIT, _nrt=True)
 #: relative to the largest diagonal entry.
 CHOLESKY_REL_PIVOT = 1e-14
 
+#: A projection onto a regime's constraints sets the components of (q, q') smaller than this
+#: in magnitude (cm, rad, cm/s, rad/s) to zero.  A locked joint's velocities s', v', psi' are
+#: zero in exact arithmetic, but their round-off decays from step to step into the subnormal
+#: doubles (below 2.2e-308; about 5e-323 cm/s) and stays there, and an operation with a
+#: subnormal operand or result is microcode-assisted on Intel processors, about a hundred
+#: times the cost of a normal one: the 10 s sine with the tip mass took 2.6 s with them and
+#: 1.4 s without on an Ice Lake Xeon (docs/performance.md).  The value is the square root of
+#: the smallest normal double, so that no product of two components is subnormal; it is far
+#: below every scale of the state (docs/model.md, 'Integration'), and what it drops changes no
+#: other component of a run.
+TINY_STATE = 1.4916681462400413e-154
+
 #: Options for small helpers (a few dozen lines at most, their own inlined
 #: callees included) called inside the time loop: inlined at numba's IR
 #: level, where LLVM would not inline them.  numba types and lowers an inlined

@@ -35,7 +35,7 @@ import numba as nb
 import numpy as np
 
 from .config import (FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, LOCK_DET_REL, NULL_COFACTOR_REL,
-                     PIVOT_REL)
+                     PIVOT_REL, TINY_STATE)
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
 from .dynamics import net_forces, solve_beams, solve_factored, solve_free
@@ -537,7 +537,8 @@ def project(y, P, free, cg, cw, rg, hold_open_below):
     new regime releases leaves from contact, not from the depth to which
     the projection onto the remaining contact carried it.  Velocities: the
     active rows' rates (normal, and tangential when sticking) to zero.
-    Only free joint coordinates move.
+    Only free joint coordinates move.  Then the components of (q, q') below
+    config.TINY_STATE are set to zero (round-off of a locked joint's rates).
 
     Returns ``(correction, drift)`` (cm): the largest |g| of the active gaps
     before the projection (the step's truncation error on the constraint)
@@ -568,6 +569,9 @@ def project(y, P, free, cg, cw, rg, hold_open_below):
         drift = max(drift, abs(cg[row_geometry_index(set_index, stick, r), ly.CG_VAL]))
     rows = n_normal + (1 if stick else 0)
     _project_rows(y, ly.N_DOF, set_index, stick, rows, np.int64(0), P, free, cg, cw)
+    for i in range(ly.N_STATE):
+        if abs(y[i]) < TINY_STATE:
+            y[i] = 0.0
     return correction, drift
 
 
