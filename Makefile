@@ -33,7 +33,7 @@ setup: $(STAMP)  ## create .venv, install the package (editable) with dev extras
 test: $(STAMP)  ## run the test suite (physics checks included)
 	$(PY) -m pytest -q -n auto --dist loadscope --no-loadscope-reorder
 
-# About 65 minutes: a cold compile (1.5), `make study` whole (44), LSODA on windows, the default grid twice (1 s per point).
+# About 46 minutes on a 2-core Ice Lake Xeon: a cold compile (1), `make study` whole (35), LSODA on windows, the default grid twice (1 s per point).
 bench: $(STAMP)  ## run the benchmarks (pytest-benchmark): JSON under .benchmarks/, tables in docs/performance.md and README.md
 	$(PY) -m pytest -q benchmarks --benchmark-only --benchmark-enable --benchmark-autosave \
 		--benchmark-columns=min,median,max,rounds -p no:randomly

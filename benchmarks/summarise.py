@@ -31,11 +31,18 @@ def saved_runs() -> list[Path]:
 
 
 def newest_by_name(paths: list[Path]) -> tuple[dict, dict]:
-    """{benchmark name: its newest entry} (each entry notes its file) and the newest run's header."""
+    """{benchmark name: its entry} (each entry notes its file) and the newest run's header.
+
+    Each test function's entries come from the newest run that has it, all of them: a
+    parameter an older run had and the newest does not (a former default tolerance) is
+    dropped with that run.
+    """
     out, header = {}, {}
     for path in paths:                          # oldest first: newer runs override
         data = json.loads(path.read_text())
         header = data
+        functions = {b["name"].split("[")[0] for b in data["benchmarks"]}
+        out = {k: v for k, v in out.items() if k.split("[")[0] not in functions}
         for b in data["benchmarks"]:
             b["source"] = path.name
             out[b["name"]] = b
@@ -139,7 +146,8 @@ def accuracy_table(b) -> list[str]:
         ratio = lsoda_ratio(b, key)
         chosen = ratio[2] if ratio else None
         for info in entries:
-            if not (info.get("default") or info is chosen):
+            if not (info.get("default") or (chosen is not None and info["solver"] == chosen["solver"]
+                                             and info["setting"] == chosen["setting"])):
                 continue                # the defaults, and LSODA at equal accuracy
             mark = " (default)" if info.get("default") else ""
             rows.append(f"| {info['case']} | {info['solver']} | {info['setting']:g}{mark} | "
