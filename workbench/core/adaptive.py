@@ -479,6 +479,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
     t = t0
     rejected = False                         # the last step tried was rejected
+    after_event = False
     m_stop = step0 + n_steps                 # the base step the call ends at
     full = False
     b_next = (step0 // decim + 1) * decim    # the next sample's base step
@@ -506,7 +507,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
-            h = _rejected(status, err, arg, h_try, h_floor, order, ctl)
+            h = _rejected(status, err, ly.N_STATE if after_event else -1, h_try, h_floor, order, ctl)
             rejected = True
             continue
         if status != ly.OK:
@@ -522,6 +523,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
                                           (stored, b_next), model, ex, work, st, out)
         if status != ly.OK:
             return status, stored, n_log
+        after_event = e >= 0
         if e < 0:
             _take_step(stages, ev, last)
             t = t_end
