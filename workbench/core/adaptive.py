@@ -102,6 +102,7 @@ def _next_step(h, err, err_prev, order):
     """The PI controller's next step (s) after an accepted step of h with estimate err."""
     e = max(err, 1e-10)
     fac = SAFETY * e ** (-(1.0 / order - 0.75 * BETA)) * err_prev ** BETA
+    fac = 1.0 + math.atan(fac - 1.0)      # Soderlind's smooth limiter
     return h * min(FAC_MAX, max(FAC_MIN, fac))
 
 
