@@ -301,3 +301,53 @@ def test_a_short_step_to_an_event_agrees_with_a_step_of_the_pair_there(rocking, 
     gap = np.max(np.abs(short - direct[:ly.N_STATE]) / scale)
     moved = np.max(np.abs(short - stages[ly.STAGE_BASE, :ly.N_STATE]) / scale)
     assert gap < 1e-3 * DEFAULT_TOL and moved > 1e3 * gap, (gap, moved)   # 7.5e-9, 4.6e-5
+
+
+def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
+    """A step whose dense output located an event (here a gap, given as located at mid-step)
+    that the pair's own states do not cross by the step's end: the search for the event's
+    state returns theta = -1, and the step is not cut there (``_to_event`` returns NOT_REACHED
+    with the state, the time and the log unchanged; the main loop tries the step shorter).
+    Taking the step's end as the event's state would apply an impact at an open gap."""
+    from workbench.core.adaptive import NOT_REACHED, _step_past, _to_event
+    from workbench.core.event_functions import event_values
+    from workbench.core.hybrid import _trial
+    from workbench.core.pair import prepare_dense
+    p, ex = rocking
+    run = simulate(p, ex, 0.05, initial="paper")
+    regime = run.sensors[:, ly.SIGNALS.index("regime")]
+    free = np.flatnonzero(regime == 0)
+    assert free.size, "the test needs a sample in free flight"
+    i = free[free.size // 2]
+    model = mdl.build(p)
+    write_tableau(model.P, DOP853)
+    work = mdl.make_work()
+    work.rg[:] = 0.0                                    # free flight
+    stages, ev = work.stages, work.ev
+    st = np.zeros(ly.N_ST)
+    t, h = run.t[i], 1e-4
+    stages[ly.STAGE_CUR] = 0.0
+    stages[ly.STAGE_CUR, :ly.N_STATE] = run.states[i]
+    y = stages[ly.STAGE_CUR].copy()
+    assert rhs_regime(t, stages[ly.STAGE_CUR], model, ex, work, stages[ly.STAGE_K1]) == ly.OK
+    event_values(stages[ly.STAGE_CUR], model.P, model.free, work.cg, work.rg, ev,
+                 ly.EV_START, ly.EV_RATE_START)
+    assert pair_step(t, stages[ly.STAGE_CUR], h, model, ex, work, st,
+                     stages[ly.STAGE_NEXT]) == ly.OK
+    event_values(stages[ly.STAGE_NEXT], model.P, model.free, work.cg, work.rg, ev,
+                 ly.EV_END, ly.EV_RATE_END)
+    assert prepare_dense(t, stages[ly.STAGE_CUR], h, model, ex, work) == ly.OK
+    gaps = ev[ly.EV_END, ly.EV_GAP:ly.EV_GAP + ly.N_POINTS]
+    e = ly.EV_GAP + int(np.argmax(gaps))
+    assert ev[ly.EV_START, e] > 0.0 and ev[ly.EV_END, e] > 0.0
+    assert _trial(0.5, t, h, np.bool_(True), model, ex, work) == ly.OK
+    ev[ly.EV_HI, e] = ev[ly.EV_TRY, e]                  # "located" at theta = 0.5
+    status, theta = _step_past(e, 0.5, t, h, model, ex, work, st)
+    assert status == ly.OK and theta == -1.0, (status, theta)
+    log = np.zeros((8, ly.N_LOG))
+    assert _trial(0.5, t, h, np.bool_(True), model, ex, work) == ly.OK
+    ev[ly.EV_HI, e] = ev[ly.EV_TRY, e]
+    status, t_after, n_log = _to_event(e, 0.5, t, h, t + 1.0, y, model, ex, work, log, 0, st)
+    assert (status, t_after, n_log) == (NOT_REACHED, t, 0)
+    np.testing.assert_array_equal(stages[ly.STAGE_CUR], y)
+    assert not log.any() and st[ly.ST_N_EVENTS] == 0.0

@@ -24,7 +24,8 @@ located there by Brent's method to EVENT_TIME_TOL; then one step of the
 pair from the step's start to the event, moved on by short steps
 (SHORT_STEP_S) to within EVENT_TIME_TOL of it, gives the state there, the event
 is applied (:func:`workbench.core.hybrid.apply_event`) and the next step
-starts from it with the step size kept.  Samples are the dense output at
+starts from it with the step size kept.  When the pair's steps do not cross
+the event by the step's end, the step is rejected and tried shorter.  Samples are the dense output at
 the output times.  An event flood (FLOOD_EVENTS within FLOOD_WINDOW_S) hands
 STEPPED_TIME_S to Moreau-Jean time-stepping.  Every decision depends on the
 state only, so a run is deterministic.
@@ -146,6 +147,10 @@ def _event_time_error(e, span, ev, ev_err):
     return ev_err[e] / slope
 
 
+#: _to_event's status (internal, never a run's) when the pair's steps do not reach the event
+#: the dense output located by the step's end (the two differ by the step's error): the step
+#: is tried again a quarter as long, or at the smallest step taken whole with no event.
+NOT_REACHED = -1
 #: Steps of the pair to the event (Newton's method on its time) at most.
 PAST_ITERS = 40
 #: The dense output's slope at an event is taken over this fraction of the step.
@@ -191,7 +196,8 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     the bracket is EVENT_TIME_TOL wide.  A move of at most SHORT_STEP_S from
     the last step of the pair is a short step from its state
     (:func:`_short_step`).  Returns ``(status, theta)``; the events at the
-    state in EV_HI.
+    state in EV_HI.  theta is -1 when the pair's states have not crossed the
+    event by the step's end (the dense output's crossing is not the pair's).
     """
     P, free = model.P, model.free
     stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
@@ -209,6 +215,8 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     last = int(P[ly.P_RK_STAGES]) - 1
     for _ in range(PAST_ITERS):
         if x >= 1.0:
+            if ev[ly.EV_END, e] >= 0.0:
+                return ly.OK, -1.0    # not crossed on the pair's states by the step's end
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
@@ -275,6 +283,18 @@ def _take_step(stages, ev, last):
 
 
 @nb.njit(**JIT)
+def _take_whole(t_end, model, ex, work):
+    """A step at the smallest size whose located event the pair's steps do not reach: its
+    end (STAGE_NEXT, at t_end, s) becomes the current state with no event; returns a status."""
+    stages, ev = work.stages, work.ev
+    _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+    _copy_ev(ev, ly.EV_END, ly.EV_START)
+    for p in range(ly.N_POINTS):
+        ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+    return rhs_regime(t_end, stages[ly.STAGE_CUR], model, ex, work, stages[ly.STAGE_K1])
+
+
+@nb.njit(**JIT)
 def _bad_input(y0, span, tolerance, P, out, log):
     """Whether run_adaptive's arrays or settings are inconsistent (ERR_BAD_INPUT)."""
     dt, n_steps, step0, decim = span
@@ -301,6 +321,13 @@ def _rejected(status, err, arg, h, h_floor, order, ctl):
     return max(h_new, h_floor)
 
 
+@nb.njit(**JIT_INLINE)
+def _noise_levels(tol, P, scale, ctl, ev):
+    """The error each event function may carry, tol times its scale, into ev[EV_NOISE]."""
+    for k in range(ly.N_EV):
+        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
+
+
 @nb.njit(**JIT)
 def _accepted(step, force, tol, before, model, work, control):
     """The account of an accepted step ``step`` = (t, h, err, arg, dt, e, theta): its
@@ -313,8 +340,7 @@ def _accepted(step, force, tol, before, model, work, control):
     ctl[ly.CTL_WORK] += 1.0
     _record_step(t, h, err, arg, dt, stages, rg, scale, ctl, floor_log, before[0], before[1])
     grow_scales(stages[ly.STAGE_NEXT], force, scale, ctl)
-    for k in range(ly.N_EV):
-        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
+    _noise_levels(tol, P, scale, ctl, ev)
     if e >= 0:
         te = _event_time_error(e, theta * h, ev, stages[ly.STAGE_TMP])
         ctl[ly.CTL_T_SSQ] += te * te
@@ -386,9 +412,12 @@ def _samples(t, t_end, h, whole, y, lattice, counts, model, ex, work, st, out):
 def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
     """After a step of h (s) from (t, y) in which event e was located at theta: one step of
     the pair from the step's start to just past it, then the event and any impact it sets
-    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log)."""
+    off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log);
+    NOT_REACHED, nothing changed, when the pair's steps do not reach the event."""
     stages, rg, ev = work.stages, work.rg, work.ev
     status, theta = _step_past(e, theta, t, h, model, ex, work, st)
+    if status == ly.OK and theta < 0.0:
+        return NOT_REACHED, t, n_log
     if status == ly.OK:
         status, e, theta = _earlier_on_steps(e, theta, t, h, model, ex, work)
     if status != ly.OK:
@@ -457,30 +486,27 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
     tol, level_max = tolerance
     P = model.P
     stages, rg, ev = work.stages, work.rg, work.ev
-    out_t, out_y, out_sig = out
     ctl, scale = control[0], control[1]
     if _bad_input(y0, span, tolerance, P, out, log):
         return ly.ERR_BAD_INPUT, 0, 0
     y = stages[ly.STAGE_CUR]
     for i in range(ly.N_AUG):
         y[i] = y0[i]
-    status, stored, n_log = begin(t0, step0, model, ex, work, out_t, out_y, out_sig, log, st)
+    status, stored, n_log = begin(t0, step0, model, ex, work, out[0], out[1], out[2], log, st)
     if status != ly.OK:
         return status, stored, n_log
     order = P[ly.P_RK_ORDER]
     last = int(P[ly.P_RK_STAGES]) - 1
     floors(P, scale)
     grow_scales(y, total_normal_force(rg), scale, ctl)
-    for k in range(ly.N_EV):
-        ev[ly.EV_NOISE, k] = tol * event_scale(k, P, scale, ctl)
+    _noise_levels(tol, P, scale, ctl, ev)
     h_floor = dt / (1 << level_max)
     h_max = max(P[ly.P_RK_STEP_FACTOR], 1.0) * dt
     h = ctl[ly.CTL_H_NEXT] if ctl[ly.CTL_H_NEXT] > 0.0 else dt
     err_prev = ctl[ly.CTL_ERR_PREV] if ctl[ly.CTL_ERR_PREV] > 0.0 else ERR_PREV_START
     t = t0
-    rejected = False                         # the last step tried was rejected
+    rejected = full = False          # the last step tried was rejected; the log is nearly full
     m_stop = step0 + n_steps                 # the base step the call ends at
-    full = False
     b_next = (step0 // decim + 1) * decim    # the next sample's base step
     while True:
         t_stop = t0 + (m_stop - step0) * dt
@@ -501,8 +527,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
                 return status, stored, n_log
             continue
         h_try = min(h, h_max, t_stop - t)
-        set_before = int(rg[ly.RG_SET])
-        stick_before = rg[ly.RG_STICK] != 0.0
+        before = (int(rg[ly.RG_SET]), rg[ly.RG_STICK] != 0.0)     # the regime (set, stick)
         status, err, arg, force, e, theta = _try_step(t, y, h_try, tol, h_floor, model, ex, work,
                                                       st, scale, ctl)
         if (status != ly.OK or err > 1.0) and h_try > h_floor * (1.0 + 1e-9):
@@ -512,8 +537,7 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         if status != ly.OK:
             st[ly.ST_T] = t
             return status, stored, n_log
-        _accepted((t, h_try, err, arg, dt, e, theta), force, tol, (set_before, stick_before),
-                  model, work, control)
+        _accepted((t, h_try, err, arg, dt, e, theta), force, tol, before, model, work, control)
         t_end = t + h_try if (e < 0 or theta >= 1.0) else t + theta * h_try
         if e < 0 and h_try == t_stop - t:
             t_end = t_stop
@@ -528,6 +552,12 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         else:
             status, t, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work, log,
                                          n_log, st)
+            if status == NOT_REACHED and h_try > h_floor * (1.0 + 1e-9):
+                h = _rejected(status, err, ly.N_STATE + e, h_try, h_floor, order, ctl)
+                rejected = True
+                continue
+            if status == NOT_REACHED:
+                status, t = _take_whole(t + h_try, model, ex, work), t + h_try
             if status != ly.OK:
                 return status, stored, n_log
         if err <= 1.0:                       # no growth right after a rejection
