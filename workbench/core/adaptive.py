@@ -146,6 +146,10 @@ def _event_time_error(e, span, ev, ev_err):
     return ev_err[e] / slope
 
 
+#: _to_event's status (internal) when the pair's steps do not reach the located event by
+#: the step's end: the dense output crossed where the pair's solution, within the step's
+#: error of it, did not; the step is tried again shorter.
+NOT_REACHED = -1
 #: Steps of the pair to the event (Newton's method on its time) at most.
 PAST_ITERS = 40
 #: The dense output's slope at an event is taken over this fraction of the step.
@@ -209,6 +213,19 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     last = int(P[ly.P_RK_STAGES]) - 1
     for _ in range(PAST_ITERS):
         if x >= 1.0:
+            st[ly.ST_N_PAST_END] += 1.0
+            if ev[ly.EV_END, e] >= 0.0:
+                st[ly.ST_N_PAST_END_UNCROSSED] += 1.0
+                return ly.OK, -1.0
+            if False:
+                st[ly.ST_N_PAST_END_UNCROSSED] += 1.0
+                st[ly.ST_PAST_INFO] = t
+                st[ly.ST_PAST_INFO + 1] = h
+                st[ly.ST_PAST_INFO + 2] = e
+                st[ly.ST_PAST_INFO + 3] = ev[ly.EV_START, e]
+                st[ly.ST_PAST_INFO + 4] = ev[ly.EV_END, e]
+                st[ly.ST_PAST_INFO + 5] = theta
+                st[ly.ST_PAST_INFO + 6] = lo
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
@@ -272,6 +289,18 @@ def _take_step(stages, ev, last):
     _copy_ev(ev, ly.EV_END, ly.EV_START)
     for p in range(ly.N_POINTS):
         ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+
+
+@nb.njit(**JIT)
+def _take_whole(t_end, model, ex, work):
+    """A step of the smallest size whose located event the pair's steps do not reach: its
+    end (STAGE_NEXT, at t_end) becomes the current state with no event; returns a status."""
+    stages, ev = work.stages, work.ev
+    _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
+    _copy_ev(ev, ly.EV_END, ly.EV_START)
+    for p in range(ly.N_POINTS):
+        ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+    return rhs_regime(t_end, stages[ly.STAGE_CUR], model, ex, work, stages[ly.STAGE_K1])
 
 
 @nb.njit(**JIT)
@@ -389,6 +418,8 @@ def _to_event(e, theta, t, h, t_stop, y, model, ex, work, log, n_log, st):
     off (Moreau-Jean time-stepping once they flood).  Returns (status, t, n_log)."""
     stages, rg, ev = work.stages, work.rg, work.ev
     status, theta = _step_past(e, theta, t, h, model, ex, work, st)
+    if status == ly.OK and theta < 0.0:
+        return NOT_REACHED, t, n_log
     if status == ly.OK:
         status, e, theta = _earlier_on_steps(e, theta, t, h, model, ex, work)
     if status != ly.OK:
@@ -528,6 +559,13 @@ def run_adaptive(y0, t0, span, tolerance, model, ex, work, out, log, st, control
         else:
             status, t, n_log = _to_event(e, theta, t, h_try, t_stop, y, model, ex, work, log,
                                          n_log, st)
+            if status == NOT_REACHED and h_try > h_floor * (1.0 + 1e-9):
+                h = _rejected(status, err, ly.N_STATE + e, h_try, h_floor, order, ctl)
+                rejected = True
+                continue
+            if status == NOT_REACHED:
+                status = _take_whole(t + h_try, model, ex, work)
+                t = t + h_try
             if status != ly.OK:
                 return status, stored, n_log
         if err <= 1.0:                       # no growth right after a rejection

@@ -354,7 +354,10 @@ ST_FLOOD_T0 = 20     # start of the window in which events are counted for a flo
 ST_FLOOD_N = 21      # events in that window
 ST_STEPPED_UNTIL = 22    # Moreau-Jean time-stepping runs until this time (s) after a flood
 ST_E_IMPACT_P = 23   # ST_E_IMPACT_P + k: the part of ST_E_IMPACT lost at point k + 1 (erg)
-N_ST = ST_E_IMPACT_P + 4
+ST_N_PAST_END = ST_E_IMPACT_P + 4   # _step_past reached the step's end
+ST_N_PAST_END_UNCROSSED = ST_N_PAST_END + 1   # ... where event e's function had not crossed
+ST_PAST_INFO = ST_N_PAST_END_UNCROSSED + 1   # t, h, e, f_start, f_end, theta0, lo
+N_ST = ST_PAST_INFO + 7
 
 # --- the error-controlled integration (workbench.core.adaptive) ----------------
 # Controller record ctl (N_CTL,): its state between calls and its statistics.

@@ -306,7 +306,7 @@ def assemble(params, ex, dt, duration, status, wall, parts_t, parts_y, parts_s, 
              "least_violated": int(st[ly.ST_N_UNRESOLVED]),
              "stepped_steps": int(st[ly.ST_N_STEPPED]),
              "stepped_energy_lost_erg": st[ly.ST_E_STEPPED],
-             "s_min_cm": st[ly.ST_S_MIN], "s_max_cm": st[ly.ST_S_MAX]}
+             "s_min_cm": st[ly.ST_S_MIN], "s_max_cm": st[ly.ST_S_MAX], "past_end": int(st[ly.ST_N_PAST_END]), "past_end_uncrossed": int(st[ly.ST_N_PAST_END_UNCROSSED]), "past_info": st[ly.ST_PAST_INFO:ly.ST_PAST_INFO + 7].tolist()}
     return Run(params=params, excitation=ex, dt=dt, duration=duration, status=int(status),
                message=ly.MESSAGES[int(status)], wall_s=wall, t=t, states=ys, sensors=sig, log=logs,
                stats=stats, static_tip_y=static_tip, initial=label, units=units, t0=t0)
