@@ -180,6 +180,28 @@ def _short_step(t, d, model, ex, work, st):
     return rhs_regime(t + d, y, model, ex, work, k)
 
 
+@nb.njit(**JIT_INLINE)
+def _pair_state_at(x, base, t, h, model, ex, work, st):
+    """The pair's state at t + x h (s) into STAGE_HI, its events into EV_HI: a short step
+    from the last step of the pair (at the fraction ``base`` of the step, in STAGE_BASE) when
+    within SHORT_STEP_S of it, else a step of the pair from the step's start (then the new
+    base).  Returns ``(status, base)``."""
+    P, stages = model.P, work.stages
+    if base >= 0.0 and abs(x - base) * h <= SHORT_STEP_S:
+        status = _short_step(t + base * h, (x - base) * h, model, ex, work, st)
+    else:
+        status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st,
+                           stages[ly.STAGE_HI])
+        if status == ly.OK:
+            base = x
+            _copy(stages, ly.STAGE_HI, ly.STAGE_BASE)
+            _copy(stages, int(P[ly.P_RK_STAGES]) - 1, ly.STAGE_KBASE)
+    if status == ly.OK:
+        event_values_after_rhs(stages[ly.STAGE_HI], P, model.free, work.cg, work.rg, work.ev,
+                               ly.EV_HI, ly.EV_RATE_TRY)
+    return status, base
+
+
 @nb.njit(**JIT)
 def _step_past(e, theta, t, h, model, ex, work, st):
     """The state just past event e by steps of the pair from the step's start (into STAGE_HI).
@@ -193,14 +215,14 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     pair's steps have found (an event function may have a kink there: a
     double contact's stick margin), moves theta until the pair's state is
     past the event by about what the function changes in EVENT_TIME_TOL, or
-    the bracket is EVENT_TIME_TOL wide.  A move of at most SHORT_STEP_S from
+    the bracket is EVENT_TIME_TOL wide (after PAST_ITERS tries, the state at
+    the bracket's far end, past the event).  A move of at most SHORT_STEP_S from
     the last step of the pair is a short step from its state
     (:func:`_short_step`).  Returns ``(status, theta)``; the events at the
     state in EV_HI.  theta is -1 when the pair's states have not crossed the
     event by the step's end (the dense output's crossing is not the pair's).
     """
-    P, free = model.P, model.free
-    stages, cg, rg, ev = work.stages, work.cg, work.rg, work.ev
+    stages, ev = work.stages, work.ev
     f_past = ev[ly.EV_HI, e]
     x = theta - SLOPE_FRACTION if theta > SLOPE_FRACTION else theta + SLOPE_FRACTION
     status = _trial(x, t, h, np.bool_(True), model, ex, work)
@@ -212,7 +234,7 @@ def _step_past(e, theta, t, h, model, ex, work, st):
     lo, hi = 0.0, 2.0            # exact f >= 0 at lo (the step's start), < 0 at hi (if <= 1)
     x = theta
     base = -1.0                  # the fraction of the last step of the pair (STAGE_BASE)
-    last = int(P[ly.P_RK_STAGES]) - 1
+    f = 0.0
     for _ in range(PAST_ITERS):
         if x >= 1.0:
             if ev[ly.EV_END, e] >= 0.0:
@@ -220,18 +242,9 @@ def _step_past(e, theta, t, h, model, ex, work, st):
             _copy(stages, ly.STAGE_NEXT, ly.STAGE_HI)
             _copy_ev(ev, ly.EV_END, ly.EV_HI)
             return ly.OK, 1.0
-        if base >= 0.0 and abs(x - base) * h <= SHORT_STEP_S:
-            status = _short_step(t + base * h, (x - base) * h, model, ex, work, st)
-        else:
-            status = pair_step(t, stages[ly.STAGE_CUR], x * h, model, ex, work, st,
-                               stages[ly.STAGE_HI])
-            if status == ly.OK:
-                base = x
-                _copy(stages, ly.STAGE_HI, ly.STAGE_BASE)
-                _copy(stages, last, ly.STAGE_KBASE)
+        status, base = _pair_state_at(x, base, t, h, model, ex, work, st)
         if status != ly.OK:
             return status, x
-        event_values_after_rhs(stages[ly.STAGE_HI], P, free, cg, rg, ev, ly.EV_HI, ly.EV_RATE_TRY)
         f = ev[ly.EV_HI, e]
         if f < 0.0:
             hi = x
@@ -246,7 +259,11 @@ def _step_past(e, theta, t, h, model, ex, work, st):
         elif not nxt > lo:
             nxt = lo + 2.0 * (lo - theta) + push     # no bracket yet: step further out
         x = min(nxt, 1.0)
-    return ly.OK, x
+    if f >= 0.0:                 # out of iterations before the event: the bracket's far end
+        if hi > 1.0:
+            return ly.OK, -1.0
+        status, base = _pair_state_at(hi, base, t, h, model, ex, work, st)
+    return status, hi
 
 
 @nb.njit(**JIT)
