@@ -255,6 +255,7 @@ def _step_past(e, theta, t, h, model, ex, work, st):
         elif not nxt > lo:
             nxt = lo + 2.0 * (lo - theta) + push     # no bracket yet: step further out
         x = min(nxt, 1.0)
+    st[ly.ST_PAST_INFO + (0 if hi > 1.0 else 1)] += 1.0
     return ly.OK, x
 
 
