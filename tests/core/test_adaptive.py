@@ -307,9 +307,10 @@ def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
     """A step whose dense output located an event (here a gap, given as located at mid-step)
     that the pair's own states do not cross by the step's end: the search for the event's
     state returns theta = -1, and the step is not cut there (``_to_event`` returns NOT_REACHED
-    with the state, the time and the log unchanged; the main loop tries the step shorter).
-    Taking the step's end as the event's state would apply an impact at an open gap."""
-    from workbench.core.adaptive import NOT_REACHED, _step_past, _to_event
+    with the state, the time and the log unchanged; the main loop tries the step shorter, and
+    at the smallest step takes it whole). Taking the step's end as the event's state would
+    apply an impact at an open gap."""
+    from workbench.core.adaptive import NOT_REACHED, _step_past, _take_whole, _to_event
     from workbench.core.event_functions import event_values
     from workbench.core.hybrid import _trial
     from workbench.core.pair import prepare_dense
@@ -351,3 +352,11 @@ def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
     assert (status, t_after, n_log) == (NOT_REACHED, t, 0)
     np.testing.assert_array_equal(stages[ly.STAGE_CUR], y)
     assert not log.any() and st[ly.ST_N_EVENTS] == 0.0
+    # at the smallest step the step is taken whole, with no event: its end is the new start
+    end, end_events = stages[ly.STAGE_NEXT].copy(), ev[ly.EV_END].copy()
+    assert _take_whole(t + h, model, ex, work) == ly.OK
+    np.testing.assert_array_equal(stages[ly.STAGE_CUR], end)
+    np.testing.assert_array_equal(ev[ly.EV_START], end_events)
+    k_end = np.empty(ly.N_AUG)
+    assert rhs_regime(t + h, end, model, ex, work, k_end) == ly.OK
+    np.testing.assert_array_equal(stages[ly.STAGE_K1], k_end)
