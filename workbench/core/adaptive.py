@@ -25,10 +25,11 @@ pair from the step's start to the event, moved on by short steps
 (SHORT_STEP_S) to within EVENT_TIME_TOL of it, gives the state there, the event
 is applied (:func:`workbench.core.hybrid.apply_event`) and the next step
 starts from it with the step size kept.  When the pair's steps do not cross
-the event by the step's end, the step is rejected and tried shorter.  Samples are the dense output at
-the output times.  An event flood (FLOOD_EVENTS within FLOOD_WINDOW_S) hands
-STEPPED_TIME_S to Moreau-Jean time-stepping.  Every decision depends on the
-state only, so a run is deterministic.
+the event by the step's end, the step is rejected and tried shorter.
+Samples are the dense output at the output times.  An event flood
+(FLOOD_EVENTS within FLOOD_WINDOW_S) hands STEPPED_TIME_S to Moreau-Jean
+time-stepping.  Every decision depends on the state only, so a run is
+deterministic.
 """
 import math
 
@@ -149,7 +150,8 @@ def _event_time_error(e, span, ev, ev_err):
 
 #: _to_event's status (internal, never a run's) when the pair's steps do not reach the event
 #: the dense output located by the step's end (the two differ by the step's error): the step
-#: is tried again a quarter as long, or at the smallest step taken whole with no event.
+#: is tried again a quarter as long, or at the smallest step taken whole with no event (the
+#: run's account counts the step among the accepted, its retry among the rejected).
 NOT_REACHED = -1
 #: Steps of the pair to the event (Newton's method on its time) at most.
 PAST_ITERS = 40
