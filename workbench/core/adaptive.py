@@ -305,11 +305,8 @@ def _take_step(stages, ev, last):
 def _take_whole(t_end, model, ex, work):
     """A step at the smallest size whose located event the pair's steps do not reach: its
     end (STAGE_NEXT, at t_end, s) becomes the current state with no event; returns a status."""
-    stages, ev = work.stages, work.ev
-    _copy(stages, ly.STAGE_NEXT, ly.STAGE_CUR)
-    _copy_ev(ev, ly.EV_END, ly.EV_START)
-    for p in range(ly.N_POINTS):
-        ev[ly.EV_RATE_START, ly.EV_GAP + p] = ev[ly.EV_RATE_END, ly.EV_GAP + p]
+    stages = work.stages
+    _take_step(stages, work.ev, int(model.P[ly.P_RK_STAGES]) - 1)   # its first stage anew below
     return rhs_regime(t_end, stages[ly.STAGE_CUR], model, ex, work, stages[ly.STAGE_K1])
 
 
