@@ -38,7 +38,8 @@ from .config import (FRICTION_REL_EPS, JIT, JIT_INLINE, LAMBDA_EPS, LOCK_DET_REL
                      PIVOT_REL, TINY_STATE)
 from . import layout as ly
 from .contact import fill_geometry, in_set, row_convective, row_rate, row_to_dof
-from .dynamics import net_forces, solve_beams, solve_factored, solve_free
+from .dynamics import (add_joint_solve, joint_block, net_forces, solve_beams, solve_factored,
+                       solve_free)
 
 
 @nb.njit(**JIT_INLINE)
@@ -160,6 +161,21 @@ def fill_delassus(free, mat, cw, m):
     for i in range(m):
         for j in range(m):
             cw[ly.CW_D + i, j] = _dot9(cw[ly.CW_A + i], cw[ly.CW_X + j])
+
+
+@nb.njit(**JIT_INLINE)
+def _joint_delassus(mat, cw, m):
+    """D = A M^-1 B^T (rows CW_D, columns 0..m-1) from M^-1's joint block (every coordinate
+    free, M's factor current): the rows act on the joint's (s, v, psi) only (set_rows)."""
+    W = joint_block(mat)
+    for j in range(m):
+        b = cw[ly.CW_B + j]
+        wb0 = W[0][0] * b[ly.S] + W[0][1] * b[ly.V] + W[0][2] * b[ly.PSI]
+        wb1 = W[1][0] * b[ly.S] + W[1][1] * b[ly.V] + W[1][2] * b[ly.PSI]
+        wb2 = W[2][0] * b[ly.S] + W[2][1] * b[ly.V] + W[2][2] * b[ly.PSI]
+        for i in range(m):
+            a = cw[ly.CW_A + i]
+            cw[ly.CW_D + i, j] = a[ly.S] * wb0 + a[ly.V] * wb1 + a[ly.PSI] * wb2
 
 
 @nb.njit(**JIT)
@@ -313,17 +329,30 @@ def add_contact_forces(y, P, free, mat, cg, cw, rg, ydot):
         sign = rg[ly.RG_SIGN]
         fill_geometry(y, P, cg)
         m = set_rows(set_index, stick, sign, P, cg, cw)
-        fill_delassus(free, mat, cw, m)
+        all_free = free.shape[0] == ly.N_DOF
+        if all_free:
+            _joint_delassus(mat, cw, m)
+        else:
+            fill_delassus(free, mat, cw, m)
         for r in range(m):
             conv = row_convective(cg, row_geometry_index(set_index, stick, r), qd)
             cw[ly.CW_D + r, ly.CW_C_COL] = -conv - _dot9(cw[ly.CW_A + r], qdd)
         small_solve(cw, m)
+        f0 = f1 = f2 = 0.0             # B^T lambda on (s, v, psi)
         for r in range(m):
             lam = cw[ly.CW_D + r, ly.CW_L_COL]
-            x = cw[ly.CW_X + r]
-            for j in range(ly.N_DOF):
-                qdd[j] += x[j] * lam
+            if all_free:
+                b = cw[ly.CW_B + r]
+                f0 += b[ly.S] * lam
+                f1 += b[ly.V] * lam
+                f2 += b[ly.PSI] * lam
+            else:
+                x = cw[ly.CW_X + r]
+                for j in range(ly.N_DOF):
+                    qdd[j] += x[j] * lam
             p_constr += lam * _dot9(cw[ly.CW_A + r], qd)
+        if all_free:
+            add_joint_solve(mat, (f0, f1, f2), qdd, cw[ly.CW_X])
         p1 = ly.SET_FIRST[set_index]
         p2 = ly.SET_SECOND[set_index]
         rg[ly.RG_LN + p1] = cw[ly.CW_D + 0, ly.CW_L_COL]

@@ -173,14 +173,27 @@ def add_applied_forces(t, q, qd, P, tab, kc, ex, rec, vec):
 #: Which rows the factor and solves take (``rows`` of :func:`_at`): the coordinates listed in
 #: ``free``, every coordinate, or the beams' (ly.BEAM_COORDS: the joint's three skipped).
 LISTED, ALL_FREE, BEAMS_ONLY = 0, 1, 2
+#: With every coordinate free the factor's rows are the beams' coordinates, then the joint's
+#: (s, v, psi) last: M^-1's joint block and a solve with a force on the joint alone need
+#: only the factor's last three rows (:func:`joint_block`, :func:`add_joint_solve`).
+JOINT_ROW = ly.N_DOF - 3
+
+
+@nb.njit(**JIT_INLINE)
+def _joint_last(i):
+    """The coordinate of the factor's row i with every coordinate free: the beams', then the
+    joint's."""
+    if i < ly.S:
+        return i
+    return i + 3 if i < JOINT_ROW else i + ly.S - JOINT_ROW
 
 
 @nb.njit(**JIT_INLINE)
 def _at(free, i, rows):
-    """Coordinate of the i-th row: free[i], i itself with every coordinate free, or the
-    i-th of the beams' coordinates (the joint's s, v, psi are 3..5)."""
+    """Coordinate of the i-th row: free[i]; with every coordinate free, the beams' coordinates
+    then the joint's; or the i-th of the beams' coordinates (the joint's s, v, psi are 3..5)."""
     if rows == ALL_FREE:
-        return i
+        return _joint_last(i)
     if rows == BEAMS_ONLY:
         return i if i < ly.S else i + (ly.PSI + 1 - ly.S)
     return free[i]
@@ -263,6 +276,47 @@ def solve_factored(free, mat, b, x):
         _solve(free, ly.N_DOF, ALL_FREE, mat, b, x)
     else:
         _solve(free, free.shape[0], LISTED, mat, b, x)
+
+
+@nb.njit(**JIT_INLINE)
+def joint_block(mat):
+    """(M^-1) on the joint's (s, v, psi), 3 x 3 as a tuple of rows, from the factor of
+    :func:`factor_free` with every coordinate free (its last three rows are the joint's):
+    W = U^T D_j^-1 U with U = L_jj^-1, L's unit lower 3 x 3 block on the joint."""
+    L = mat[ly.MAT_CHOL]
+    j = JOINT_ROW
+    l10, l20, l21 = L[j + 1, j], L[j + 2, j], L[j + 2, j + 1]
+    u10, u20, u21 = -l10, l10 * l21 - l20, -l21
+    d0, d1, d2 = L[j, j], L[j + 1, j + 1], L[j + 2, j + 2]
+    w00 = d0 + d1 * u10 * u10 + d2 * u20 * u20
+    w01 = d1 * u10 + d2 * u20 * u21
+    w02 = d2 * u20
+    w11 = d1 + d2 * u21 * u21
+    w12 = d2 * u21
+    return ((w00, w01, w02), (w01, w11, w12), (w02, w12, d2))
+
+
+@nb.njit(**JIT_INLINE)
+def add_joint_solve(mat, f, x, y):
+    """x += M^-1 (f on the joint's s, v, psi; f a 3-tuple): the factor of :func:`factor_free`
+    with every coordinate free, whose forward substitution touches its last three rows only;
+    y (9,) is scratch."""
+    L = mat[ly.MAT_CHOL]
+    j = JOINT_ROW
+    z0 = f[0]
+    z1 = f[1] - L[j + 1, j] * z0
+    z2 = f[2] - L[j + 2, j] * z0 - L[j + 2, j + 1] * z1
+    for i in range(j):
+        y[i] = 0.0
+    y[j] = z0 * L[j, j]
+    y[j + 1] = z1 * L[j + 1, j + 1]
+    y[j + 2] = z2 * L[j + 2, j + 2]
+    for i in range(ly.N_DOF - 1, -1, -1):
+        acc = y[i]
+        for k in range(i + 1, ly.N_DOF):
+            acc -= L[k, i] * y[k]
+        y[i] = acc
+        x[_joint_last(i)] += acc
 
 
 @nb.njit(**JIT_INLINE)
