@@ -303,33 +303,21 @@ def test_a_short_step_to_an_event_agrees_with_a_step_of_the_pair_there(rocking, 
     assert gap < 1e-3 * DEFAULT_TOL and moved > 1e3 * gap, (gap, moved)   # 7.5e-9, 4.6e-5
 
 
-def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
-    """A step whose dense output located an event (here a gap, given as located at mid-step)
-    that the pair's own states do not cross by the step's end: the search for the event's
-    state returns theta = -1, and the step is not cut there (``_to_event`` returns NOT_REACHED
-    with the state, the time and the log unchanged; the main loop tries the step shorter, and
-    at the smallest step takes it whole). Taking the step's end as the event's state would
-    apply an impact at an open gap."""
-    from workbench.core.adaptive import NOT_REACHED, _step_past, _take_whole, _to_event
+def _free_flight_step(p, ex, run, i, h):
+    """A step of the pair of h (s) from the rocking run's sample i (in free flight), as the
+    kernel leaves it before locating an event: its start's first stage and events, its end
+    and events, its dense output's stages.  Returns (model, work, st, the start's state)."""
     from workbench.core.event_functions import event_values
-    from workbench.core.hybrid import _trial
     from workbench.core.pair import prepare_dense
-    p, ex = rocking
-    run = simulate(p, ex, 0.05, initial="paper")
-    regime = run.sensors[:, ly.SIGNALS.index("regime")]
-    free = np.flatnonzero(regime == 0)
-    assert free.size, "the test needs a sample in free flight"
-    i = free[free.size // 2]
     model = mdl.build(p)
     write_tableau(model.P, DOP853)
     work = mdl.make_work()
     work.rg[:] = 0.0                                    # free flight
     stages, ev = work.stages, work.ev
     st = np.zeros(ly.N_ST)
-    t, h = run.t[i], 1e-4
+    t = run.t[i]
     stages[ly.STAGE_CUR] = 0.0
     stages[ly.STAGE_CUR, :ly.N_STATE] = run.states[i]
-    y = stages[ly.STAGE_CUR].copy()
     assert rhs_regime(t, stages[ly.STAGE_CUR], model, ex, work, stages[ly.STAGE_K1]) == ly.OK
     event_values(stages[ly.STAGE_CUR], model.P, model.free, work.cg, work.rg, ev,
                  ly.EV_START, ly.EV_RATE_START)
@@ -338,6 +326,27 @@ def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
     event_values(stages[ly.STAGE_NEXT], model.P, model.free, work.cg, work.rg, ev,
                  ly.EV_END, ly.EV_RATE_END)
     assert prepare_dense(t, stages[ly.STAGE_CUR], h, model, ex, work) == ly.OK
+    return model, work, st, stages[ly.STAGE_CUR].copy()
+
+
+def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
+    """A step whose dense output located an event (here a gap, given as located at mid-step)
+    that the pair's own states do not cross by the step's end: the search for the event's
+    state returns theta = -1, and the step is not cut there (``_to_event`` returns NOT_REACHED
+    with the state, the time and the log unchanged; the main loop tries the step shorter, and
+    at the smallest step takes it whole). Taking the step's end as the event's state would
+    apply an impact at an open gap."""
+    from workbench.core.adaptive import NOT_REACHED, _step_past, _take_whole, _to_event
+    from workbench.core.hybrid import _trial
+    p, ex = rocking
+    run = simulate(p, ex, 0.05, initial="paper")
+    regime = run.sensors[:, ly.SIGNALS.index("regime")]
+    free = np.flatnonzero(regime == 0)
+    assert free.size, "the test needs a sample in free flight"
+    i = free[free.size // 2]
+    t, h = run.t[i], 1e-4
+    model, work, st, y = _free_flight_step(p, ex, run, i, h)
+    stages, ev = work.stages, work.ev
     gaps = ev[ly.EV_END, ly.EV_GAP:ly.EV_GAP + ly.N_POINTS]
     e = ly.EV_GAP + int(np.argmax(gaps))
     assert ev[ly.EV_START, e] > 0.0 and ev[ly.EV_END, e] > 0.0
@@ -360,3 +369,74 @@ def test_an_event_the_pairs_steps_do_not_reach_is_not_applied(rocking):
     k_end = np.empty(ly.N_AUG)
     assert rhs_regime(t + h, end, model, ex, work, k_end) == ly.OK
     np.testing.assert_array_equal(stages[ly.STAGE_K1], k_end)
+
+
+@pytest.mark.parametrize("past, bracket", [(0.1, True), (-0.2, False)])
+def test_a_search_out_of_iterations_keeps_the_state_past_the_event_or_none(rocking, past,
+                                                                            bracket, monkeypatch):
+    """The search for an event's state (``_step_past``) misled by the slope it is given: the
+    gap of the rocking run's first impact from free flight, in a step of the pair whose dense
+    output crosses it at mid-step.  Started 0.1 of the step past the crossing with 1/1.99 of
+    the dense output's slope, its Newton steps overshoot by 0.99 of the distance, alternating
+    sides; started 0.2 before it with 50 times the slope, they creep towards it.  Both run out
+    of PAST_ITERS tries, the last before the event.  With a bracket the search returns its far
+    end, past the event, and the state there (a step of the pair to that fraction); without
+    one it returns -1, not reached.  The compiled kernel does what its Python source does, in
+    which the tries are counted.  (Returning the last try's state, before the event, with
+    another fraction fails both.)"""
+    import workbench.core.adaptive as adaptive
+    from workbench.core.hybrid import _trial
+    p, ex = rocking
+    run = simulate(p, ex, 0.05, initial="paper")
+    regime = run.sensors[:, ly.SIGNALS.index("regime")]
+    impacts = run.events[(run.events.kind == "impact") & (run.events.from_regime == 0)]
+    t_impact, point = float(impacts.t.iloc[0]), int(impacts.point.iloc[0])
+    i = int(np.searchsorted(run.t, t_impact)) - 1
+    assert regime[i] == 0, "the test needs the sample before the impact in free flight"
+    h = 2.0 * (t_impact - run.t[i])
+    e = ly.EV_GAP + point - 1
+    tries = []
+
+    def search(kernel):
+        model, work, st, _ = _free_flight_step(p, ex, run, i, h)
+        t, ev, stages = run.t[i], work.ev, work.stages
+        assert ev[ly.EV_START, e] > 0.0 > ev[ly.EV_END, e]
+
+        def dense_value(x):
+            assert _trial(x, t, h, np.bool_(True), model, ex, work) == ly.OK
+            return ev[ly.EV_TRY, e]
+        lo, hi = 0.0, 1.0                               # the dense output's crossing
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if dense_value(mid) >= 0.0 else (lo, mid)
+        theta, ratio = hi + past, 1.99 if bracket else 0.02
+        f_theta, f_slope = dense_value(theta), dense_value(theta - adaptive.SLOPE_FRACTION)
+        dense_value(theta)
+        stages[ly.STAGE_HI] = stages[ly.STAGE_TRY]
+        ev[ly.EV_HI] = ev[ly.EV_TRY]
+        ev[ly.EV_HI, e] = f_slope - (f_slope - f_theta) / ratio    # the slope misread
+        status, found = kernel(e, theta, t, h, model, ex, work, st)
+        assert status == ly.OK
+        return found, stages[ly.STAGE_HI].copy(), ev[ly.EV_HI, e], (model, work, st, t)
+
+    found, state, value, _ = search(adaptive._step_past)
+    pair_state_at = adaptive._pair_state_at
+
+    def counted(x, *args):
+        tries.append(x)
+        return pair_state_at(x, *args)
+    monkeypatch.setattr(adaptive, "_pair_state_at", counted)
+    found_py, state_py, value_py, (model, work, st, t) = search(adaptive._step_past.py_func)
+    assert found_py == found and value_py == value
+    np.testing.assert_array_equal(state_py, state)
+    if not bracket:
+        assert found == -1.0 and len(tries) == adaptive.PAST_ITERS, (found, len(tries))
+        return
+    assert len(tries) == adaptive.PAST_ITERS + 1 and tries[-1] == found   # the far end, again
+    assert 0.0 < found < 1.0 and value < 0.0
+    direct = np.empty(ly.N_AUG)
+    assert rhs_regime(t, work.stages[ly.STAGE_CUR], model, ex, work,
+                      work.stages[ly.STAGE_K1]) == ly.OK
+    assert pair_step(t, work.stages[ly.STAGE_CUR], found * h, model, ex, work, st,
+                     direct) == ly.OK
+    np.testing.assert_array_equal(direct, state)
