@@ -410,8 +410,8 @@ def test_a_search_out_of_iterations_keeps_the_state_past_the_event_or_none(rocki
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if dense_value(mid) >= 0.0 else (lo, mid)
         theta, ratio = hi + past, 1.99 if bracket else 0.02
-        f_theta, f_slope = dense_value(theta), dense_value(theta - adaptive.SLOPE_FRACTION)
-        dense_value(theta)
+        f_slope = dense_value(theta - adaptive.SLOPE_FRACTION)
+        f_theta = dense_value(theta)                    # its state in STAGE_TRY
         stages[ly.STAGE_HI] = stages[ly.STAGE_TRY]
         ev[ly.EV_HI] = ev[ly.EV_TRY]
         ev[ly.EV_HI, e] = f_slope - (f_slope - f_theta) / ratio    # the slope misread
